@@ -1,0 +1,41 @@
+"""Compilation settings shared by every compiled kernel.
+
+Numba's on-disk cache is keyed by the timestamp of the file that defines a function, not by the
+files it calls, so editing ``plant/dynamics.py`` would leave a stale cached ``simulation/engine.py``
+kernel.  We therefore place the cache in a directory named by a hash of *all* package sources:
+any source change selects a fresh directory.  Set ``AUVTRACK_CACHE_DIR`` to override the root.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+
+_PKG = Path(__file__).resolve().parent
+
+
+def source_hash() -> str:
+    """Return a SHA-256 digest of every ``*.py`` file of the package (paths and contents)."""
+    h = hashlib.sha256()
+    for path in sorted(_PKG.rglob("*.py")):
+        h.update(str(path.relative_to(_PKG)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def cache_dir() -> Path:
+    """Return the numba cache directory for the current package sources."""
+    root = Path(os.environ.get("AUVTRACK_CACHE_DIR", Path.home() / ".cache" / "auvtrack"))
+    return root / f"numba-{numba.__version__}-{source_hash()[:16]}"
+
+
+numba.config.CACHE_DIR = str(cache_dir())
+
+
+def njit(*args, **kwargs):
+    """``numba.njit`` with the project's defaults: on-disk cache, NumPy error model (1/0 -> inf)."""
+    kwargs.setdefault("cache", True)
+    kwargs.setdefault("error_model", "numpy")
+    return numba.njit(*args, **kwargs)

@@ -1,0 +1,158 @@
+"""Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce``.
+
+Bad input (a scenario error, a missing file, an invalid gain) prints ONE line to stderr and
+exits with status 2, never a traceback.  A simulation that fails (divergence, pitch limit,
+envelope violation) keeps and saves its partial result, prints the diagnostic and exits 3.
+"""
+from __future__ import annotations
+
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import click
+
+EXIT_BAD_INPUT = 2
+EXIT_SIM_FAILED = 3
+
+
+class BadInput(click.ClickException):
+    """Any user error: shown as one line, exit status 2."""
+
+    exit_code = EXIT_BAD_INPUT
+
+    def show(self, file=None) -> None:  # noqa: D102 - one line, no "Error:" banner
+        click.echo(f"auvtrack: error: {self.format_message()}", err=True)
+
+
+def _load(scenario: str, overrides: tuple[str, ...]):
+    from .scenario import load_scenario
+
+    return load_scenario(scenario, list(overrides))
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="auvtrack")
+def cli() -> None:
+    """auvtrack: trajectory-tracking control of underactuated AUVs."""
+
+
+set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
+                          help="Override a scenario key, e.g. --set sim.dt=0.002 (repeatable).")
+
+
+@cli.command()
+@click.argument("scenario")
+@click.option("--out", type=click.Path(file_okay=False), default=None, help="Run folder (default runs/<name>).")
+@set_option
+@click.option("--mat", is_flag=True, help="Also write trajectory.mat (MATLAB).")
+def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -> None:
+    """Simulate SCENARIO (a TOML file) and write trajectory.csv and run.json."""
+    from .simulation.api import prepare, run_prepared
+
+    sc = _load(scenario, overrides)
+    prep = prepare(sc)
+    for note in prep.notes:
+        click.echo(f"warning: {note}", err=True)
+    res = run_prepared(prep)
+    folder = res.save(Path(out) if out else Path("runs") / sc.name, mat=mat or sc.output.mat)
+    click.echo(f"{res!r}\nwritten: {folder}")
+    if not res.ok:
+        f = res.failure
+        click.echo(f"auvtrack: simulation failed at t = {f['time']:.6g} s: {f['cause']}: {f['detail']}; "
+                   f"state {json.dumps(f['state'])}; partial result kept in {folder}", err=True)
+        raise click.exceptions.Exit(EXIT_SIM_FAILED)
+
+
+@cli.command()
+@click.argument("scenario")
+@set_option
+def check(scenario: str, overrides: tuple[str, ...]) -> None:
+    """Validate SCENARIO without running it."""
+    sc = _load(scenario, overrides)
+    if sc.controller.kind == "fxtntsmc":
+        from .control.theory import check_theorem1
+
+        for v in check_theorem1(sc.controller):
+            click.echo(f"warning: {v}", err=True)
+    click.echo(f"ok: {scenario} ({sc.name}: controller {sc.controller.kind}, "
+               f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s)")
+
+
+@cli.command()
+@click.argument("scenario")
+@set_option
+@click.option("--gamma1", default=0.5, show_default=True, help="Lemma 1 constant in (0, 1).")
+@click.option("--g1", default=0.5, show_default=True, help="Tuning constant of eq. (45) in (0, 1).")
+@click.option("--g2", default=0.5, show_default=True, help="Tuning constant of eq. (50) in (0, 1).")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON instead of text.")
+def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, g2: float, as_json: bool) -> None:
+    """Print Theorem 1's fixed-time bounds for the gains of SCENARIO."""
+    from .control.theory import fixed_time_bounds
+
+    sc = _load(scenario, overrides)
+    if sc.controller.kind != "fxtntsmc":
+        raise BadInput(f"controller.kind: bounds exist for 'fxtntsmc' only (got {sc.controller.kind!r})")
+    b = fixed_time_bounds(sc.controller, gamma1=gamma1, g1=g1, g2=g2, horizon=sc.sim.duration)
+    click.echo(json.dumps(b.to_dict(), indent=2) if as_json else b.report())
+
+
+@cli.command()
+@click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: ftsmc, fxtntsmc).")
+@click.option("--repeat", default=7, show_default=True, help="Timed repetitions; the median is reported.")
+@click.option("--duration", default=20.0, show_default=True, help="Simulated seconds per repetition.")
+def bench(controllers: tuple[str, ...], repeat: int, duration: float) -> None:
+    """Time the compiled closed loop; one JSON line per controller with us_per_step."""
+    from .studies.bench import bench_single
+
+    for kind in controllers or ("ftsmc", "fxtntsmc"):
+        click.echo(json.dumps(bench_single(kind, repeat=repeat, duration=duration)))
+
+
+@cli.command()
+def warmup() -> None:
+    """Compile (or load from the cache) every kernel once."""
+    from .studies.bench import warmup as _warmup
+
+    click.echo(json.dumps(_warmup()))
+
+
+@cli.command()
+@click.option("--out", type=click.Path(file_okay=False), default="reproduce", show_default=True)
+@click.option("--quick", is_flag=True, help="Short horizon (smoke test).")
+def reproduce(out: str, quick: bool) -> None:
+    """Reproduce the paper's Section 4: both controllers, Figures 3-8, metrics and verdicts."""
+    from .studies.reproduce import reproduce as _reproduce
+
+    summary = _reproduce(Path(out), quick=quick, progress=True)
+    click.echo(summary)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``auvtrack`` console script; returns the exit status."""
+    from .scenario import ScenarioError
+
+    warnings.simplefilter("default")
+    try:
+        cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
+    except click.exceptions.Exit as e:
+        return e.exit_code
+    except click.ClickException as e:
+        e.show()
+        return e.exit_code
+    except click.exceptions.Abort:
+        click.echo("auvtrack: aborted", err=True)
+        return 130
+    except (ScenarioError, ValueError, KeyError, OSError) as e:
+        click.echo(f"auvtrack: error: {_one_line(e)}", err=True)
+        return EXIT_BAD_INPUT
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

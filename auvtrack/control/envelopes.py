@@ -1,0 +1,171 @@
+"""Prescribed-performance envelopes (paper eq. 16-25, corrected per ERRATA 7-10).
+
+Each axis i has the envelope rho = rho1(t) + rho_bar, with the baseline rho1 of eq. (24) and
+the adjustment rho_bar, an internal controller state driven by
+
+    rho_bar_dot = -lambda1 rho_bar + lambda2 g tanh(|xi| / lambda3),   xi = e / rho       (eq. 25)
+
+where the trigger g in [0, 1] defines the scheme:
+
+==========  ====  ==============================================================================
+scheme      code  trigger g
+==========  ====  ==============================================================================
+none        0     no envelope: no error transformation (z = e)
+rigid       1     g = 0: rho = rho1 (plus the decaying start widening, if any)
+reactive    2     g = smoothstep(|xi|) rising from 0 to 1 over [thr - 0.05, thr]: the "passive"
+                  schemes the paper argues against, acting once |xi| approaches the bound
+proactive   3     g = gamma(hbar) of eq. (22), hbar = zeta_dot + delta zeta, zeta = 1 - xi^2
+                  (eq. 20-21): the paper's risk monitor, acting on the predicted trend
+==========  ====  ==============================================================================
+
+Algebraic loops (ERRATA 10), both solved exactly here:
+
+1. hbar needs xi_dot, hence rho_dot, which contains g = gamma(hbar).  hbar is affine in g,
+   hbar = h0 + k g with k >= 0, and gamma is non-increasing, so g - gamma(h0 + k g) is
+   strictly increasing on [0, 1]: one root, found by safeguarded Newton iteration.
+2. rho_ddot (needed by U_dot in the control law) depends on e_ddot through hbar_dot, i.e. on
+   the input.  It is affine, rho_ddot = p + q e_ddot, and :func:`axis_transform` returns p, q
+   so the control law can solve for e_ddot in closed form.
+"""
+from __future__ import annotations
+
+import math
+
+from .._jit import njit
+
+NONE, RIGID, REACTIVE, PROACTIVE = 0, 1, 2, 3
+ENVELOPES = {"none": NONE, "rigid": RIGID, "reactive": REACTIVE, "proactive": PROACTIVE}
+REACTIVE_BAND = 0.05
+
+
+@njit
+def baseline(t, rho0, rho_inf, T, printed):
+    """Baseline envelope rho1 of eq. (24) and its first two derivatives (m, m/s, m/s^2).
+
+    Corrected (ERRATA 7): rho1 = (rho0 - rho_inf) exp(-t / (T - t)) + rho_inf for t < T,
+    rho_inf afterwards; C-infinity at T.  ``printed``: the form as printed, without
+    + rho_inf for t < T (decays to 0 at T, then jumps to rho_inf).
+    """
+    if t >= T:
+        return rho_inf, 0.0, 0.0
+    s = T - t
+    phi = -t / s
+    if phi < -700.0:
+        return (0.0 if printed else rho_inf), 0.0, 0.0
+    a = (rho0 - rho_inf) * math.exp(phi)
+    d1 = -T / (s * s)
+    d2 = -2.0 * T / (s * s * s)
+    r = a if printed else a + rho_inf
+    return r, a * d1, a * (d1 * d1 + d2)
+
+
+@njit
+def risk_indicator(h, eps):
+    """Smooth indicator gamma(hbar) of eq. (22) and its derivative d gamma / d hbar."""
+    if h <= 0.0:
+        return 1.0, 0.0
+    if h >= 2.0 * eps:
+        return 0.0, 0.0
+    s = h / (2.0 * eps)
+    return 1.0 - 3.0 * s * s + 2.0 * s * s * s, (-6.0 * s + 6.0 * s * s) / (2.0 * eps)
+
+
+@njit
+def reactive_trigger(a, thr):
+    """C1 smoothstep of |xi| = a over [thr - REACTIVE_BAND, thr] and its derivative."""
+    lo = thr - REACTIVE_BAND
+    if a <= lo:
+        return 0.0, 0.0
+    if a >= thr:
+        return 1.0, 0.0
+    s = (a - lo) / REACTIVE_BAND
+    return 3.0 * s * s - 2.0 * s * s * s, (6.0 * s - 6.0 * s * s) / REACTIVE_BAND
+
+
+@njit
+def solve_risk_loop(h0, k, eps):
+    """Solve g = gamma(h0 + k g) on [0, 1] (loop 1 of ERRATA 10); k >= 0; returns g."""
+    lo, hi = 0.0, 1.0
+    g, _ = risk_indicator(h0, eps)
+    for _ in range(60):
+        gam, dgam = risk_indicator(h0 + k * g, eps)
+        F = g - gam
+        if abs(F) <= 1e-15:
+            break
+        if F > 0.0:
+            hi = g
+        else:
+            lo = g
+        g_new = g - F / (1.0 - k * dgam)  # F' = 1 - k gamma' >= 1
+        g = g_new if lo < g_new < hi else 0.5 * (lo + hi)
+    return g
+
+
+@njit
+def axis_transform(kind, t, e, ed, rb, ep, i, out):
+    """Envelope and error transformation of axis ``i`` (eq. 17-19, 23-25); returns status.
+
+    ``ep`` = [T, delta, eps, lambda1, lambda2, lambda3, thr, printed, rho0(3), rho_inf(3)].
+    Writes into ``out``: 0 z, 1 z_dot, 2 Omega, 3 U, 4 Omega_dot, 5 c0, 6 c1, 7 rho,
+    8 rho_bar_dot, 9 rho1, 10 g — where U_dot e = c0 + c1 e_ddot collects every U_dot term
+    (loop 2 of ERRATA 10), so that z_ddot = Omega_dot e_dot + Omega e_ddot - (c0 + c1 e_ddot)
+    - U e_dot.  Status 1 if |e| >= rho (outside the envelope).
+    """
+    if kind == NONE:
+        out[0], out[1], out[2], out[3], out[4], out[5], out[6] = e, ed, 1.0, 0.0, 0.0, 0.0, 0.0
+        out[7], out[8], out[9], out[10] = math.nan, 0.0, math.nan, 0.0
+        return 0
+    T, delta, eps, lam1, lam2, lam3 = ep[0], ep[1], ep[2], ep[3], ep[4], ep[5]
+    rho1, rho1d, rho1dd = baseline(t, ep[8 + i], ep[11 + i], T, ep[7] != 0.0)
+    rho = rho1 + rb
+    xi = e / rho
+    if not abs(xi) < 1.0:
+        return 1
+    axi = abs(xi)
+    th = math.tanh(axi / lam3)
+    dth = (1.0 - th * th) / lam3
+    sgn = 1.0 if xi > 0.0 else (-1.0 if xi < 0.0 else 0.0)
+    base = rho1d - lam1 * rb
+    g, gd_h, gd_a, c_h = 0.0, 0.0, 0.0, 0.0
+    if kind == PROACTIVE:
+        # hbar = -2 xi xi_dot + delta (1 - xi^2), xi_dot = e_dot/rho - e rho_dot/rho^2 (eq. 20-21)
+        h0 = -2.0 * xi * ed / rho + delta * (1.0 - xi * xi) + 2.0 * xi * xi / rho * base
+        k = 2.0 * xi * xi / rho * lam2 * th
+        g = solve_risk_loop(h0, k, eps)
+        _, gd_h = risk_indicator(h0 + k * g, eps)
+    elif kind == REACTIVE:
+        g, gd_a = reactive_trigger(axi, ep[6])
+    rbd = -lam1 * rb + lam2 * g * th
+    rhod = rho1d + rbd
+    xid = ed / rho - e * rhod / (rho * rho)
+    axid = sgn * xid
+    # rho_ddot = p + q e_ddot
+    rbdd_0 = -lam1 * rbd + lam2 * (g * dth + gd_a * th) * axid
+    q = 0.0
+    if kind == PROACTIVE:
+        c_h = lam2 * th * gd_h  # <= 0
+        # hbar_dot = -2 xid^2 - 2 xi xidd - 2 delta xi xid, xidd = edd/rho + X0 - e rhodd/rho^2
+        X0 = -2.0 * ed * rhod / (rho * rho) + 2.0 * e * rhod * rhod / (rho * rho * rho)
+        K0 = rho1dd + rbdd_0 + c_h * (-2.0 * xid * xid - 2.0 * delta * xi * xid)
+        den = 1.0 - 2.0 * c_h * xi * e / (rho * rho)  # >= 1
+        p = (K0 - 2.0 * c_h * xi * X0) / den
+        q = -(2.0 * c_h * xi / rho) / den
+    else:
+        p = rho1dd + rbdd_0
+    D = rho * rho - e * e
+    Om = rho / D
+    U = rhod / D
+    Dd = 2.0 * rho * rhod - 2.0 * e * ed
+    out[0] = 0.5 * math.log((1.0 + xi) / (1.0 - xi))
+    out[1] = Om * ed - U * e
+    out[2] = Om
+    out[3] = U
+    out[4] = rhod / D - rho * Dd / (D * D)
+    # U_dot = rho_ddot / D - rho_dot Dd / D^2
+    out[5] = (p / D - rhod * Dd / (D * D)) * e
+    out[6] = q / D * e
+    out[7] = rho
+    out[8] = rbd
+    out[9] = rho1
+    out[10] = g
+    return 0

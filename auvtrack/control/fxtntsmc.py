@@ -1,0 +1,163 @@
+"""FXTNTSMC: the paper's fixed-time nonsingular terminal SMC (eq. 26-32, corrected).
+
+Per axis i, with z the transformed error of eq. (17) and the envelope of
+:mod:`auvtrack.control.envelopes`:
+
+    S   = z_dot + S1(S_e),  S_e = a1 sig^a2(z) + a3 sig^a4(z)                   (eq. 26, 28)
+    S1  = sig^alpha(S_e) if |S_e| > sigma, else beta1 S_e + beta2 sign(S_e) S_e^2   (eq. 27)
+    nu  = -kappa1 sign S - kappa2 sig^3 S - kappa3 S                            (reaching law)
+
+The input makes S_dot = nu + Omega (chi - chi_hat) (ERRATA 13, derivation in
+docs/derivation.md): from z_ddot = Omega_dot e_dot + Omega e_ddot - U_dot e - U e_dot,
+
+    e_ddot* = [nu - S1_dot - Omega_dot e_dot + U_dot e + U e_dot] / Omega     (Omega^-1 on nu)
+    tau_bar = M_bar J3^-1 (e_ddot* - chi_hat - J3_dot v1 - J4_dot + eta_d_ddot) + C_bar v1 + D_bar v1 + G_bar
+
+where U_dot contains e_ddot itself (loop 2 of ERRATA 10), solved in closed form.
+The |z|^(a2-1) of S1_dot (ERRATA 12) is handled by ``surface``: "nonsingular" replaces
+sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the same device as
+eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
+
+Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels: rho, rho1, chi_hat, S,
+the trigger g of the envelope, per axis.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import njit
+from . import envelopes, rbf
+from .registry import CompiledController
+from .tracking import error_state, input_for_accel, sign
+
+CODE = 2
+AXES = ("x", "y", "z")
+AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "S", "g") for a in AXES)
+
+# packed parameters
+K1, K2, K3, A1, A2, A3, A4, ALPHA, SIGMA, SURF, ZSW, ZFL = range(12)
+ENV, EP0 = 12, 13  # envelope kind, then the 14 envelope parameters of envelopes.axis_transform
+EST, NEUR, WIDTH, CENT = 27, 28, 29, 30
+SURFACES = {"nonsingular": 0, "printed": 1}
+MAX_NEURONS = 400  # psi lives in the engine's scratch (dispatch.WORK_SIZE)
+
+
+class StartOutsideEnvelope(ValueError):
+    """The initial error lies on or outside the envelope and the start treatment is off."""
+
+
+@njit
+def surface(z, a1, a2, a3, a4, printed, zs, zfloor):
+    """S_e(z) of eq. (28) and dS_e/dz, singular-free unless ``printed`` (ERRATA 12)."""
+    az = abs(z)
+    s = sign(z)
+    if not printed and az <= zs:
+        c1 = (2.0 - a2) * zs ** (a2 - 1.0)
+        c2 = (a2 - 1.0) * zs ** (a2 - 2.0)
+        g, dg = c1 * z + c2 * s * z * z, c1 + 2.0 * c2 * az
+    else:
+        g, dg = s * az**a2, a2 * max(az, zfloor) ** (a2 - 1.0)
+    return a1 * g + a3 * s * az**a4, a1 * dg + a3 * a4 * az ** (a4 - 1.0)
+
+
+@njit
+def switch(se, alpha, sigma):
+    """S1(S_e) of eq. (27) and its derivative; C1 at |S_e| = sigma."""
+    a = abs(se)
+    if a > sigma:
+        return sign(se) * a**alpha, alpha * a ** (alpha - 1.0)
+    b1 = (2.0 - alpha) * sigma ** (alpha - 1.0)
+    b2 = (alpha - 1.0) * sigma ** (alpha - 2.0)
+    return b1 * se + b2 * sign(se) * se * se, b1 + 2.0 * b2 * a
+
+
+@njit
+def control(t, eta, nu, xc, refm, vp, cp, tau, dxc, aux, work):
+    """Compiled FXTNTSMC law; status 1 if an error leaves its envelope."""
+    e, ed, f, acc = work[0:3], work[3:6], work[6:9], work[9:12]
+    error_state(eta, nu, refm, vp, e, ed, f, work[16:48])
+    kind = int(cp[ENV])
+    est = int(cp[EST])
+    m = int(cp[NEUR])
+    tr = work[60:71]
+    psi = work[80 : 80 + m]
+    if est != rbf.NONE:
+        rbf.basis(e, ed, cp[CENT : CENT + 6 * m], cp[WIDTH], psi)
+    printed = cp[SURF] != 0.0
+    for i in range(3):
+        status = envelopes.axis_transform(kind, t, e[i], ed[i], xc[i], cp[EP0 : EP0 + 14], i, tr)
+        if status != 0:
+            return status
+        z, zd, Om, U, Omd, c0, c1 = tr[0], tr[1], tr[2], tr[3], tr[4], tr[5], tr[6]
+        se, dse = surface(z, cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL])
+        s1, dphi = switch(se, cp[ALPHA], cp[SIGMA])
+        S = zd + s1
+        reach = -cp[K1] * sign(S) - cp[K2] * S * S * S - cp[K3] * S
+        edd = (reach - dphi * dse * zd - Omd * ed[i] + c0 + U * ed[i]) / (Om - c1)
+        chat = 0.0
+        if est != rbf.NONE:
+            W = xc[3 + i * m : 3 + (i + 1) * m]
+            gain = Om if est == rbf.OMEGA else 1.0
+            chat = rbf.estimate_and_adapt(W, psi, S, gain, dxc[3 + i * m : 3 + (i + 1) * m])
+        acc[i] = edd - chat
+        dxc[i] = tr[8]
+        aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i] = tr[7], tr[9], chat, S, tr[10]
+    input_for_accel(eta, nu, vp, f, acc, tau, work[16:48])
+    return 0
+
+
+def start_widening(e0, rho1_0, xi0: float, widen: bool) -> tuple[np.ndarray, list[str]]:
+    """Initial rho_bar (ERRATA 9): rho_bar_i(0) = max(0, |e_i(0)| / xi0 - rho1_i(0)).
+
+    Widening applies on every axis where |e_i(0)| / rho1_i(0) > xi0 and is reported; with
+    ``widen`` false a start on or outside the envelope (ratio >= 1) raises
+    :class:`StartOutsideEnvelope` and a start inside it is left as it is.
+    """
+    rb = np.zeros(3)
+    notes = []
+    for i, a in enumerate(AXES):
+        ratio = abs(e0[i]) / rho1_0[i]
+        if widen and ratio > xi0:
+            rb[i] = abs(e0[i]) / xi0 - rho1_0[i]
+            notes.append(
+                f"envelope: start at |e_{a}(0)|/rho1_{a}(0) = {ratio:.4g} (>= xi0 = {xi0}); "
+                f"rho_bar_{a}(0) widened by {rb[i]:.6g} m so that |e_{a}(0)|/rho_{a}(0) = {xi0}"
+            )
+        elif not widen and ratio >= 1.0:
+            raise StartOutsideEnvelope(
+                f"envelope: the start lies on or outside the envelope on axis {a} "
+                f"(|e_{a}(0)| = {abs(e0[i]):.6g} m >= rho_{a}(0) = {rho1_0[i]:.6g} m); "
+                "set envelope.widen_start = true or enlarge envelope.rho0"
+            )
+    return rb, notes
+
+
+def setup(scenario, ctx) -> CompiledController:
+    """Pack gains, envelope and network of the scenario; apply the start treatment."""
+    p, env, est = scenario.controller, scenario.envelope, scenario.estimator
+    kind = envelopes.ENVELOPES[env.kind]
+    rho0, rho_inf = np.asarray(env.rho0, float), np.asarray(env.rho_inf, float)
+    printed = env.baseline == "printed"
+    notes: list[str] = []
+    rb0 = np.zeros(3)
+    if kind != envelopes.NONE:
+        rho1_0 = np.array([envelopes.baseline(0.0, rho0[i], rho_inf[i], env.T, printed)[0] for i in range(3)])
+        rb0, notes = start_widening(ctx.e0, rho1_0, env.xi0, env.widen_start)
+    m = est.neurons if est.kind != "none" else 0
+    if m > MAX_NEURONS:
+        raise ValueError(f"estimator.neurons: at most {MAX_NEURONS} (got {m})")
+    centres, weights = rbf.draw_network(ctx.seed, m, est.centre_range, est.weight_range)
+    cp = np.concatenate([
+        [p.kappa1, p.kappa2, p.kappa3, p.a1, p.a2, p.a3, p.a4, p.alpha, p.sigma,
+         SURFACES[p.surface], p.z_switch, p.z_floor, kind,
+         env.T, env.delta, env.epsilon, env.lambda1, env.lambda2, env.lambda3, env.reactive_threshold,
+         float(printed)], rho0, rho_inf,
+        [rbf.ESTIMATORS[est.kind], m, est.width], centres.ravel(),
+    ]).astype(np.float64)
+    assert cp.size == CENT + 6 * m
+    xc0 = np.concatenate([rb0, weights.ravel()])
+    resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
+    return CompiledController(code=CODE, cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),
+                              resolved=resolved)

@@ -1,0 +1,58 @@
+"""Adaptive RBF network estimating the lumped disturbance chi (paper eq. 11-13, 33, 34).
+
+chi_hat_i = W_i^T psi(x),  psi_j(x) = exp(-||x - c_j||^2 / (2 b^2)),  x = [e, e_dot] in R^6,
+with m Gaussian neurons shared by the three axes and one weight vector W_i in R^m per axis.
+Adaptive laws (ERRATA 14):
+
+* ``printed`` (eq. 34 as printed):       W_i_dot = psi S_i - W_i (W_i^T W_i)
+* ``omega``   (Lyapunov-consistent):     W_i_dot = Omega_i psi S_i - W_i (W_i^T W_i)
+
+The Omega factor is what the Lyapunov argument of Theorem 1 needs, because chi enters
+S_dot multiplied by Omega (eq. 19).  Centres and initial weights are drawn from the scenario
+seed (stream "rbf") as in Section 4: centres uniform in [-1, 1], weights uniform in [0, 1].
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import njit
+from .._seeding import rng
+
+NONE, PRINTED, OMEGA = 0, 1, 2
+ESTIMATORS = {"none": NONE, "printed": PRINTED, "omega": OMEGA}
+N_INPUT = 6
+
+
+@njit
+def basis(e, ed, centres, width, out):
+    """Gaussian basis psi(x) of eq. (12) for x = [e, e_dot]; ``centres`` is flat (m * 6,)."""
+    inv = 1.0 / (2.0 * width * width)
+    for j in range(out.shape[0]):
+        d2 = 0.0
+        for k in range(3):
+            a = e[k] - centres[j * N_INPUT + k]
+            b = ed[k] - centres[j * N_INPUT + 3 + k]
+            d2 += a * a + b * b
+        out[j] = math.exp(-d2 * inv)
+
+
+@njit
+def estimate_and_adapt(W, psi, S_i, gain, dW):
+    """Return chi_hat_i = W^T psi and write W_dot = gain psi S_i - W (W^T W) (eq. 33-34)."""
+    chat, w2 = 0.0, 0.0
+    for j in range(W.shape[0]):
+        chat += W[j] * psi[j]
+        w2 += W[j] * W[j]
+    for j in range(W.shape[0]):
+        dW[j] = gain * psi[j] * S_i - W[j] * w2
+    return chat
+
+
+def draw_network(seed: int, neurons: int, centre_range, weight_range) -> tuple[np.ndarray, np.ndarray]:
+    """Seeded centres (m, 6) and initial weights (3, m) of the network."""
+    g = rng(seed, "rbf")
+    centres = g.uniform(centre_range[0], centre_range[1], size=(neurons, N_INPUT))
+    weights = g.uniform(weight_range[0], weight_range[1], size=(3, neurons))
+    return centres, weights

@@ -1,0 +1,82 @@
+"""Vehicle presets: model numbers stored as data, each with its unit and source.
+
+Presets live in ``auvtrack/data/vehicles/*.toml``; each number is a table with ``value``,
+``unit`` and ``source`` so that ``run.json`` and the docs can cite where every parameter came
+from.  Use :func:`get_preset` to read one and :func:`pack_vehicle` to build the packed ``vp``
+array of :mod:`auvtrack.plant.params`.
+"""
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+
+import numpy as np
+
+from .params import CSCALE, D0, ELL, M0, VP_SIZE, WGML
+
+_FIELDS = ("m", "d", "wgml", "l")
+
+
+@dataclass(frozen=True)
+class VehiclePreset:
+    """Nominal 5-DOF vehicle: diagonal inertia, linear damping, restoring coefficient, offset.
+
+    Attributes
+    ----------
+    name, description : str
+        Identifier and one-line description.
+    m : tuple of 5 float
+        m11, m22, m33 (kg) and m44, m55 (kg m^2), rigid body plus added mass.
+    d : tuple of 5 float
+        Linear damping d11, d22, d33 (N s/m) and d44, d55 (N m s/rad).
+    wgml : float
+        rho g nabla GM_L, pitch restoring coefficient (N m).
+    l : float
+        Virtual-point offset ell of eq. (2) (m).
+    sources : dict
+        Per field: ``{"unit": ..., "source": ...}``.
+    """
+
+    name: str
+    description: str
+    m: tuple[float, ...]
+    d: tuple[float, ...]
+    wgml: float
+    l: float
+    sources: dict
+
+
+def available() -> list[str]:
+    """Names of the presets shipped with the package."""
+    root = resources.files("auvtrack") / "data" / "vehicles"
+    return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
+
+
+def get_preset(name: str) -> VehiclePreset:
+    """Load preset ``name``; raise ``KeyError`` naming the available presets."""
+    if name not in available():
+        raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available()}")
+    text = (resources.files("auvtrack") / "data" / "vehicles" / f"{name}.toml").read_text()
+    raw = tomllib.loads(text)
+    vals = {k: raw[k]["value"] for k in _FIELDS}
+    return VehiclePreset(
+        name=raw["name"],
+        description=raw.get("description", ""),
+        m=tuple(float(x) for x in vals["m"]),
+        d=tuple(float(x) for x in vals["d"]),
+        wgml=float(vals["wgml"]),
+        l=float(vals["l"]),
+        sources={k: {"unit": raw[k]["unit"], "source": raw[k]["source"]} for k in _FIELDS},
+    )
+
+
+def pack_vehicle(m, d, wgml: float, l: float, c_scale: float = 1.0) -> np.ndarray:
+    """Pack vehicle numbers into the ``vp`` layout of :mod:`auvtrack.plant.params`."""
+    vp = np.zeros(VP_SIZE)
+    vp[M0 : M0 + 5] = m
+    vp[D0 : D0 + 5] = d
+    vp[WGML] = wgml
+    vp[ELL] = l
+    vp[CSCALE] = c_scale
+    return vp
