@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from auvtrack.plant.dynamics import generalized_forces, nu_dot
-from auvtrack.plant.kinematics import eta_dot, j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
+from auvtrack.plant.kinematics import attitude, eta_dot, j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
 from auvtrack.plant.presets import get_preset, pack_vehicle
 
 angles = st.floats(-1.3, 1.3)
@@ -32,9 +32,8 @@ def _rotation_zyx(ps, th):
 @given(angles, angles)
 def test_j1_is_the_rotation_without_roll(th, ps):
     """ERRATA 1: J1 equals Rz(psi) Ry(theta) (the printed J1 is wrong)."""
-    out = np.zeros(5)
     nu = np.array([0.7, -0.3, 0.2, 0.0, 0.0])
-    eta_dot(np.array([0, 0, 0, th, ps]), nu, out)
+    out = np.array(eta_dot(attitude(th, ps), tuple(nu)))
     np.testing.assert_allclose(out[:3], _rotation_zyx(ps, th) @ nu[:3], atol=1e-14)
     np.testing.assert_allclose(out[:3], _j1(th, ps) @ nu[:3], atol=1e-14)
 
@@ -45,23 +44,20 @@ def test_virtual_point_velocity_by_finite_differences(th, ps, u, v, w, q, r, ell
     """d/dt eta1 = J3 v1 + J4 (eq. 3, corrected J3[2,1] = -ell cos theta, ERRATA 2)."""
     eta, nu = _state(th, ps, u, v, w, q, r)
     h = 1e-6
-    d = np.zeros(5)
-    eta_dot(eta, nu, d)
-    pp, pm = np.zeros(3), np.zeros(3)
-    virtual_point(eta + h * d, ell, pp)
-    virtual_point(eta - h * d, ell, pm)
-    fd = (pp - pm) / (2 * h)
-    J3, J4 = np.zeros((3, 3)), np.zeros(3)
-    j3(th, ps, ell, J3)
-    j4(th, ps, v, w, J4)
+    d = np.array(eta_dot(attitude(th, ps), tuple(nu)))
+
+    def p1(x):
+        return np.array(virtual_point(tuple(x), attitude(x[3], x[4]), ell))
+
+    fd = (p1(eta + h * d) - p1(eta - h * d)) / (2 * h)
+    J3 = np.array(j3(attitude(th, ps), ell))
+    J4 = np.array(j4(attitude(th, ps), v, w))
     np.testing.assert_allclose(J3 @ np.array([u, q, r]) + J4, fd, atol=1e-8)
 
 
 @given(angles, angles, ells)
 def test_det_j3_is_ell_squared_and_inverse_is_exact(th, ps, ell):
-    J3, Ji = np.zeros((3, 3)), np.zeros((3, 3))
-    j3(th, ps, ell, J3)
-    j3_inv(th, ps, ell, Ji)
+    J3, Ji = np.array(j3(attitude(th, ps), ell)), np.array(j3_inv(attitude(th, ps), ell))
     assert math.isclose(abs(np.linalg.det(J3)), ell**2, rel_tol=1e-12)
     np.testing.assert_allclose(Ji @ J3, np.eye(3), atol=1e-12)
 
@@ -72,17 +68,13 @@ def test_j3_dot_and_j4_dot_by_finite_differences(th, ps, u, v, w, q, r, ell, vd,
     """J3_dot, J4_dot along a trajectory with theta_dot = q, psi_dot = r / cos(theta)."""
     thd, psd = q, r / math.cos(th)
     h = 1e-6
-    A, B = np.zeros((3, 3)), np.zeros((3, 3))
-    j3(th + h * thd, ps + h * psd, ell, A)
-    j3(th - h * thd, ps - h * psd, ell, B)
-    Jd = np.zeros((3, 3))
-    j3_dot(th, ps, thd, psd, ell, Jd)
+    A = np.array(j3(attitude(th + h * thd, ps + h * psd), ell))
+    B = np.array(j3(attitude(th - h * thd, ps - h * psd), ell))
+    Jd = np.array(j3_dot(attitude(th, ps), thd, psd, ell))
     np.testing.assert_allclose(Jd, (A - B) / (2 * h), atol=1e-8)
-    a, b = np.zeros(3), np.zeros(3)
-    j4(th + h * thd, ps + h * psd, v + h * vd, w + h * wd, a)
-    j4(th - h * thd, ps - h * psd, v - h * vd, w - h * wd, b)
-    J4d = np.zeros(3)
-    j4_dot(th, ps, v, w, thd, psd, vd, wd, J4d)
+    a = np.array(j4(attitude(th + h * thd, ps + h * psd), v + h * vd, w + h * wd))
+    b = np.array(j4(attitude(th - h * thd, ps - h * psd), v - h * vd, w - h * wd))
+    J4d = np.array(j4_dot(attitude(th, ps), v, w, thd, psd, vd, wd))
     np.testing.assert_allclose(J4d, (a - b) / (2 * h), atol=1e-8)
 
 
@@ -102,11 +94,10 @@ def test_kinetics_match_the_matrix_form():
         tau3, omega = rng.normal(size=3), rng.normal(size=5)
         G = np.array([0, 0, 0, pre.wgml * math.sin(eta[3]), 0])
         rhs = np.array([tau3[0], 0, 0, tau3[1], tau3[2]]) + omega - 1.1 * C0 @ nu - np.diag(pre.d) @ nu - G
-        out = np.zeros(5)
-        nu_dot(eta, nu, tau3, omega, vp, out)
+        att = attitude(eta[3], eta[4])
+        out = np.array(nu_dot(att, tuple(nu), tuple(tau3), tuple(omega), vp))
         np.testing.assert_allclose(out, rhs / np.array(pre.m), rtol=1e-12, atol=1e-14)
-        gf = np.zeros(5)
-        generalized_forces(eta, nu, vp, gf)
+        gf = np.array(generalized_forces(att, tuple(nu), vp))
         # reduced model (eq. 4): rows u, q, r of C nu are C_bar v1 with the printed C_bar
         Cbar = np.array([[0, m33 * w, -m22 * v], [(m11 - m33) * w, 0, 0], [(m22 - m11) * v, 0, 0]])
         v1 = np.array([u, q, r])

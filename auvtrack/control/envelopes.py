@@ -101,26 +101,29 @@ def solve_risk_loop(h0, k, eps):
     return g
 
 
-@njit
-def axis_transform(kind, t, e, ed, rb, ep, i, out):
-    """Envelope and error transformation of axis ``i`` (eq. 17-19, 23-25); returns status.
+N_PARAMS = 14
+OUTSIDE = (math.nan,) * 11
 
-    ``ep`` = [T, delta, eps, lambda1, lambda2, lambda3, thr, printed, rho0(3), rho_inf(3)].
-    Writes into ``out``: 0 z, 1 z_dot, 2 Omega, 3 U, 4 Omega_dot, 5 c0, 6 c1, 7 rho,
-    8 rho_bar_dot, 9 rho1, 10 g — where U_dot e = c0 + c1 e_ddot collects every U_dot term
-    (loop 2 of ERRATA 10), so that z_ddot = Omega_dot e_dot + Omega e_ddot - (c0 + c1 e_ddot)
-    - U e_dot.  Status 1 if |e| >= rho (outside the envelope).
+
+@njit
+def axis_transform(kind, t, e, ed, rb, ep, off, i):
+    """Envelope and error transformation of axis ``i`` (eq. 17-19, 23-25).
+
+    ``ep[off : off + 14]`` = [T, delta, eps, lambda1, lambda2, lambda3, thr, printed,
+    rho0 (3), rho_inf (3)].  Returns (status, values) with status 1 if |e| >= rho (outside the
+    envelope) and values = (z, z_dot, Omega, U, Omega_dot, c0, c1, rho, rho_bar_dot, rho1, g),
+    where U_dot e = c0 + c1 e_ddot collects every U_dot term (loop 2 of ERRATA 10), so that
+    z_ddot = Omega_dot e_dot + Omega e_ddot - (c0 + c1 e_ddot) - U e_dot.
     """
     if kind == NONE:
-        out[0], out[1], out[2], out[3], out[4], out[5], out[6] = e, ed, 1.0, 0.0, 0.0, 0.0, 0.0
-        out[7], out[8], out[9], out[10] = math.nan, 0.0, math.nan, 0.0
-        return 0
-    T, delta, eps, lam1, lam2, lam3 = ep[0], ep[1], ep[2], ep[3], ep[4], ep[5]
-    rho1, rho1d, rho1dd = baseline(t, ep[8 + i], ep[11 + i], T, ep[7] != 0.0)
+        return 0, (e, ed, 1.0, 0.0, 0.0, 0.0, 0.0, math.nan, 0.0, math.nan, 0.0)
+    T, delta, eps = ep[off], ep[off + 1], ep[off + 2]
+    lam1, lam2, lam3 = ep[off + 3], ep[off + 4], ep[off + 5]
+    rho1, rho1d, rho1dd = baseline(t, ep[off + 8 + i], ep[off + 11 + i], T, ep[off + 7] != 0.0)
     rho = rho1 + rb
     xi = e / rho
     if not abs(xi) < 1.0:
-        return 1
+        return 1, OUTSIDE
     axi = abs(xi)
     th = math.tanh(axi / lam3)
     dth = (1.0 - th * th) / lam3
@@ -134,7 +137,7 @@ def axis_transform(kind, t, e, ed, rb, ep, i, out):
         g = solve_risk_loop(h0, k, eps)
         _, gd_h = risk_indicator(h0 + k * g, eps)
     elif kind == REACTIVE:
-        g, gd_a = reactive_trigger(axi, ep[6])
+        g, gd_a = reactive_trigger(axi, ep[off + 6])
     rbd = -lam1 * rb + lam2 * g * th
     rhod = rho1d + rbd
     xid = ed / rho - e * rhod / (rho * rho)
@@ -156,16 +159,9 @@ def axis_transform(kind, t, e, ed, rb, ep, i, out):
     Om = rho / D
     U = rhod / D
     Dd = 2.0 * rho * rhod - 2.0 * e * ed
-    out[0] = 0.5 * math.log((1.0 + xi) / (1.0 - xi))
-    out[1] = Om * ed - U * e
-    out[2] = Om
-    out[3] = U
-    out[4] = rhod / D - rho * Dd / (D * D)
-    # U_dot = rho_ddot / D - rho_dot Dd / D^2
-    out[5] = (p / D - rhod * Dd / (D * D)) * e
-    out[6] = q / D * e
-    out[7] = rho
-    out[8] = rbd
-    out[9] = rho1
-    out[10] = g
-    return 0
+    z = 0.5 * math.log((1.0 + xi) / (1.0 - xi))
+    Omd = rhod / D - rho * Dd / (D * D)
+    # U_dot = rho_ddot / D - rho_dot Dd / D^2, rho_ddot = p + q e_ddot
+    c0 = (p / D - rhod * Dd / (D * D)) * e
+    c1 = q / D * e
+    return 0, (z, Om * ed - U * e, Om, U, Omd, c0, c1, rho, rbd, rho1, g)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit
+from ..plant.kinematics import attitude
 from .params import FTSMCParams
 from .registry import CompiledController
 from .tracking import error_state, input_for_accel, sig, sign
@@ -26,16 +27,22 @@ AUX_NAMES = ("s_x", "s_y", "s_z")
 
 
 @njit
-def control(t, eta, nu, xc, refm, vp, cp, tau, dxc, aux, work):
+def reaching(e, ed, beta, gam, k1, k2):
+    """Sliding variable s and commanded e_ddot of one axis."""
+    s = e + beta * sig(ed, gam)
+    return s, -sig(ed, 2.0 - gam) / (beta * gam) - k1 * sign(s) - k2 * s
+
+
+@njit
+def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FTSMC law; returns status 0 (it has no failure modes of its own)."""
-    beta, gam, k1, k2 = cp[0], cp[1], cp[2], cp[3]
-    e, ed, f, acc = work[0:3], work[3:6], work[6:9], work[9:12]
-    error_state(eta, nu, refm, vp, e, ed, f, work[16:48])
-    for i in range(3):
-        s = e[i] + beta * sig(ed[i], gam)
-        acc[i] = -sig(ed[i], 2.0 - gam) / (beta * gam) - k1 * sign(s) - k2 * s
-        aux[i] = s
-    input_for_accel(eta, nu, vp, f, acc, tau, work[16:48])
+    att = attitude(eta[3], eta[4])
+    e, ed, f = error_state(eta, att, nu, refm, vp)
+    s0, a0 = reaching(e[0], ed[0], cp[0], cp[1], cp[2], cp[3])
+    s1, a1 = reaching(e[1], ed[1], cp[0], cp[1], cp[2], cp[3])
+    s2, a2 = reaching(e[2], ed[2], cp[0], cp[1], cp[2], cp[3])
+    aux[0], aux[1], aux[2] = s0, s1, s2
+    tau[0], tau[1], tau[2] = input_for_accel(att, nu, vp, f, (a0, a1, a2))
     return 0
 
 

@@ -30,6 +30,8 @@ import numpy as np
 from .._jit import njit
 from . import envelopes, rbf
 from .registry import CompiledController
+from ..plant.kinematics import attitude
+from .dispatch_layout import NX_PLANT, WORK_SIZE
 from .tracking import error_state, input_for_accel, sign
 
 CODE = 2
@@ -41,7 +43,9 @@ K1, K2, K3, A1, A2, A3, A4, ALPHA, SIGMA, SURF, ZSW, ZFL = range(12)
 ENV, EP0 = 12, 13  # envelope kind, then the 14 envelope parameters of envelopes.axis_transform
 EST, NEUR, WIDTH, CENT = 27, 28, 29, 30
 SURFACES = {"nonsingular": 0, "printed": 1}
-MAX_NEURONS = 400  # psi lives in the engine's scratch (dispatch.WORK_SIZE)
+XC = NX_PLANT  # internal state [rho_bar (3), W (3 m)] starts here in X
+ACC = WORK_SIZE - 3  # scratch slots of the commanded e_ddot
+MAX_NEURONS = ACC  # the basis psi occupies work[0:m]
 
 
 class StartOutsideEnvelope(ValueError):
@@ -74,23 +78,22 @@ def switch(se, alpha, sigma):
 
 
 @njit
-def control(t, eta, nu, xc, refm, vp, cp, tau, dxc, aux, work):
-    """Compiled FXTNTSMC law; status 1 if an error leaves its envelope."""
-    e, ed, f, acc = work[0:3], work[3:6], work[6:9], work[9:12]
-    error_state(eta, nu, refm, vp, e, ed, f, work[16:48])
-    kind = int(cp[ENV])
-    est = int(cp[EST])
-    m = int(cp[NEUR])
-    tr = work[60:71]
-    psi = work[80 : 80 + m]
+def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
+    """Compiled FXTNTSMC law; status 1 if an error leaves its envelope.
+
+    ``work[0:m]`` holds the RBF basis and ``work[ACC:ACC + 3]`` the commanded e_ddot.
+    """
+    att = attitude(eta[3], eta[4])
+    e, ed, f = error_state(eta, att, nu, refm, vp)
+    kind, est, m = int(cp[ENV]), int(cp[EST]), int(cp[NEUR])
     if est != rbf.NONE:
-        rbf.basis(e, ed, cp[CENT : CENT + 6 * m], cp[WIDTH], psi)
+        rbf.basis(e, ed, cp, CENT, m, cp[WIDTH], work)
     printed = cp[SURF] != 0.0
     for i in range(3):
-        status = envelopes.axis_transform(kind, t, e[i], ed[i], xc[i], cp[EP0 : EP0 + 14], i, tr)
+        status, tr = envelopes.axis_transform(kind, t, e[i], ed[i], X[XC + i], cp, EP0, i)
         if status != 0:
             return status
-        z, zd, Om, U, Omd, c0, c1 = tr[0], tr[1], tr[2], tr[3], tr[4], tr[5], tr[6]
+        z, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
         se, dse = surface(z, cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL])
         s1, dphi = switch(se, cp[ALPHA], cp[SIGMA])
         S = zd + s1
@@ -98,13 +101,12 @@ def control(t, eta, nu, xc, refm, vp, cp, tau, dxc, aux, work):
         edd = (reach - dphi * dse * zd - Omd * ed[i] + c0 + U * ed[i]) / (Om - c1)
         chat = 0.0
         if est != rbf.NONE:
-            W = xc[3 + i * m : 3 + (i + 1) * m]
             gain = Om if est == rbf.OMEGA else 1.0
-            chat = rbf.estimate_and_adapt(W, psi, S, gain, dxc[3 + i * m : 3 + (i + 1) * m])
-        acc[i] = edd - chat
-        dxc[i] = tr[8]
-        aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i] = tr[7], tr[9], chat, S, tr[10]
-    input_for_accel(eta, nu, vp, f, acc, tau, work[16:48])
+            chat = rbf.estimate_and_adapt(X, XC + 3 + i * m, m, work, S, gain, dX)
+        work[ACC + i] = edd - chat
+        dX[XC + i] = rbd
+        aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i] = rho, rho1, chat, S, g
+    tau[0], tau[1], tau[2] = input_for_accel(att, nu, vp, f, (work[ACC], work[ACC + 1], work[ACC + 2]))
     return 0
 
 

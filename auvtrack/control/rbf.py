@@ -26,27 +26,33 @@ N_INPUT = 6
 
 
 @njit
-def basis(e, ed, centres, width, out):
-    """Gaussian basis psi(x) of eq. (12) for x = [e, e_dot]; ``centres`` is flat (m * 6,)."""
+def basis(e, ed, cp, off, m, width, psi):
+    """Gaussian basis psi(x) of eq. (12), x = [e, e_dot], written to psi[0:m].
+
+    The centres are ``cp[off : off + 6 m]``, row j = (c_e (3), c_e_dot (3)).
+    """
     inv = 1.0 / (2.0 * width * width)
-    for j in range(out.shape[0]):
+    for j in range(m):
         d2 = 0.0
         for k in range(3):
-            a = e[k] - centres[j * N_INPUT + k]
-            b = ed[k] - centres[j * N_INPUT + 3 + k]
+            a = e[k] - cp[off + j * N_INPUT + k]
+            b = ed[k] - cp[off + j * N_INPUT + 3 + k]
             d2 += a * a + b * b
-        out[j] = math.exp(-d2 * inv)
+        psi[j] = math.exp(-d2 * inv)
 
 
 @njit
-def estimate_and_adapt(W, psi, S_i, gain, dW):
-    """Return chi_hat_i = W^T psi and write W_dot = gain psi S_i - W (W^T W) (eq. 33-34)."""
+def estimate_and_adapt(X, off, m, psi, S_i, gain, dX):
+    """chi_hat_i = W^T psi (eq. 33) with W = X[off : off + m]; dX gets W_dot (eq. 34).
+
+    W_dot = gain psi S_i - W (W^T W), gain = 1 (printed law) or Omega_i (Omega-weighted law).
+    """
     chat, w2 = 0.0, 0.0
-    for j in range(W.shape[0]):
-        chat += W[j] * psi[j]
-        w2 += W[j] * W[j]
-    for j in range(W.shape[0]):
-        dW[j] = gain * psi[j] * S_i - W[j] * w2
+    for j in range(m):
+        chat += X[off + j] * psi[j]
+        w2 += X[off + j] * X[off + j]
+    for j in range(m):
+        dX[off + j] = gain * psi[j] * S_i - X[off + j] * w2
     return chat
 
 

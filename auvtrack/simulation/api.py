@@ -13,7 +13,7 @@ from .. import __version__
 from ..control import get as get_controller
 from ..control.dispatch import CONTROLLER_STATUS
 from ..environment import build_disturbance, pack_disturbances
-from ..plant.kinematics import virtual_point
+from ..plant.kinematics import attitude, virtual_point
 from ..plant.presets import get_preset, pack_vehicle
 from ..reference import build_reference
 from ..scenario import Scenario, load_scenario
@@ -105,8 +105,7 @@ def prepare(scenario: Scenario) -> Prepared:
     nu0 = np.array(sc.initial.nu, dtype=float)
     p0, v0, a0 = ref.evaluate(0.0)
     refm0 = np.vstack([p0, v0, a0])
-    p1 = np.zeros(3)
-    virtual_point(eta0, vp_nom[engine.ELL], p1)
+    p1 = np.array(virtual_point(tuple(eta0), attitude(eta0[3], eta0[4]), vp_nom[engine.ELL]))
     ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed)
     cc = get_controller(sc.controller.kind).setup(sc, ctx)
     dt = sc.sim.dt
@@ -132,7 +131,7 @@ def run_prepared(prep: Prepared) -> Result:
     metrics_init(acc)
     fail_state = np.zeros(prep.X0.size)
     wall = time.perf_counter()
-    cause, rows, t_stop = engine.run_kernel(prep.X0, prep.si, prep.sf, prep.cp, prep.vp_nom, prep.vp_true,
+    cause, rows, t_stop = engine.run_kernel(int(prep.si[engine.SI_CODE]), prep.X0, prep.si, prep.sf, prep.cp, prep.vp_nom, prep.vp_true,
                                             prep.ref_p, prep.d_rows, prep.d_cur, log, acc, fail_state)
     wall = time.perf_counter() - wall
     failure = None if cause == engine.CAUSE_NONE else _failure(cause, t_stop, fail_state, prep)

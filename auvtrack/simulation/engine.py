@@ -9,21 +9,24 @@ weights, envelope filters) are integrated together.  Two modes:
 
 One row is logged every ``log_every`` steps into a preallocated array (O(N) in total).  After
 every step the state is checked; a failure stops the run at once and keeps what was logged.
-
 Integer settings ``si`` and float settings ``sf`` use the index constants below.
+
+Performance note: arrays are passed whole and indexed, never sliced, in the hot path (a slice
+is a reference-counted view whose atomic inc/decrements cost more than the arithmetic).
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
+from numba import literally
 
 from .._jit import njit
-from ..control.dispatch import WORK_SIZE, control
+from ..control.dispatch import NX_PLANT, WORK_SIZE, control
 from ..control.tracking import lumped_disturbance
 from ..environment import eval_disturbance
 from ..plant.dynamics import nu_dot
-from ..plant.kinematics import eta_dot, virtual_point
+from ..plant.kinematics import attitude, eta_dot, virtual_point
 from ..plant.params import ELL
 from ..reference import eval_reference
 from .metrics import metrics_update
@@ -33,7 +36,6 @@ SI_SIZE = 6
 SF_DT, SF_THETA_LIM, SF_STATE_LIM, SF_WIN_T0, SF_WIN_T1 = range(5)
 SF_SIZE = 5
 
-NX_PLANT = 10
 # logged row: t, eta(5), nu(5), tau(3), eta_d(3), e(3), aux(naux), chi(3)
 N_BASE_COLS = 20
 
@@ -44,46 +46,55 @@ CAUSES = {
     CAUSE_PITCH: "pitch limit exceeded (|theta| beyond sim.theta_limit)",
     CAUSE_STATE_LIMIT: "state limit exceeded (divergence, |state| > sim.state_limit)",
 }
+STATUS_NONFINITE_INPUT = 3
 
 
 @njit
-def closed_loop_rhs(t, X, si, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, dX, tau, aux, refm, omega, work):
-    """Write dX/dt; return 0 or a controller status.  ``hold`` = [tau(3), dxc] in sampled mode."""
-    eta = X[0:5]
-    nu = X[5:10]
+def plant_state(X):
+    """(eta, nu) tuples of the plant part of X."""
+    return (X[0], X[1], X[2], X[3], X[4]), (X[5], X[6], X[7], X[8], X[9])
+
+
+@njit
+def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, dX, tau, aux,
+                    refm, omega, work):
+    """Write dX/dt; return 0 or a controller status.  ``hold`` = [tau (3), dxc] in sampled mode."""
+    literally(code)
+    eta, nu = plant_state(X)
     eval_reference(ref_p, t, refm)
-    nc = si[SI_NC]
-    if si[SI_CTRL_EVERY] == 0:
-        status = control(si[SI_CODE], t, eta, nu, X[10:], refm, vp_nom, cp, tau, dX[10:], aux, work)
+    if ctrl_every == 0:
+        status = control(code, t, eta, nu, X, refm, vp_nom, cp, tau, dX, aux, work)
         if status != 0:
             return status
     else:
-        for i in range(3):
-            tau[i] = hold[i]
-        for i in range(nc):
-            dX[10 + i] = hold[3 + i]
+        tau[0], tau[1], tau[2] = hold[0], hold[1], hold[2]
+        for i in range(NX_PLANT, nx):
+            dX[i] = hold[3 + i - NX_PLANT]
     eval_disturbance(d_rows, d_cur, t, eta, nu, vp_true, omega)
-    eta_dot(eta, nu, dX[0:5])
-    nu_dot(eta, nu, tau, omega, vp_true, dX[5:10])
+    att = attitude(eta[3], eta[4])
+    dX[0], dX[1], dX[2], dX[3], dX[4] = eta_dot(att, nu)
+    dX[5], dX[6], dX[7], dX[8], dX[9] = nu_dot(att, nu, (tau[0], tau[1], tau[2]),
+                                               (omega[0], omega[1], omega[2], omega[3], omega[4]), vp_true)
     return 0
 
 
 @njit
-def _log_row(row, t, X, tau, refm, e, aux, naux, dnu_true, vp_nom, omega, dnu_nom):
+def _log_row(log, row, t, X, tau, refm, e, aux, naux, dX, vp_nom):
     """Fill one logged row (see N_BASE_COLS); chi uses the nominal model with the same input."""
-    row[0] = t
+    log[row, 0] = t
     for i in range(10):
-        row[1 + i] = X[i]
+        log[row, 1 + i] = X[i]
     for i in range(3):
-        row[11 + i] = tau[i]
-        row[14 + i] = refm[0, i]
-        row[17 + i] = e[i]
+        log[row, 11 + i] = tau[i]
+        log[row, 14 + i] = refm[0, i]
+        log[row, 17 + i] = e[i]
     for i in range(naux):
-        row[20 + i] = aux[i]
-    for i in range(5):
-        omega[i] = 0.0
-    nu_dot(X[0:5], X[5:10], tau, omega, vp_nom, dnu_nom)
-    lumped_disturbance(X[0:5], dnu_true, dnu_nom, vp_nom[ELL], row[20 + naux : 23 + naux])
+        log[row, 20 + i] = aux[i]
+    eta, nu = plant_state(X)
+    att = attitude(eta[3], eta[4])
+    dnu_nom = nu_dot(att, nu, (tau[0], tau[1], tau[2]), (0.0, 0.0, 0.0, 0.0, 0.0), vp_nom)
+    chi = lumped_disturbance(att, (dX[5], dX[6], dX[7], dX[8], dX[9]), dnu_nom, vp_nom[ELL])
+    log[row, 20 + naux], log[row, 21 + naux], log[row, 22 + naux] = chi
 
 
 @njit
@@ -105,79 +116,84 @@ def _finite3(v):
 
 
 @njit
-def run_kernel(X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state):
-    """Integrate the closed loop; return (cause, rows_logged, t_stop).
+def _fail(status, X, fail_state):
+    for i in range(X.shape[0]):
+        fail_state[i] = X[i]
+    return status
 
-    ``log`` has shape (n_rows, N_BASE_COLS + naux + 3); ``acc`` is the metrics accumulator;
-    on failure the state at the stop is copied into ``fail_state``.
+
+@njit
+def run_kernel(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state):
+    """Integrate the closed loop of controller ``code``; return (cause, rows_logged, t_stop).
+
+    ``code`` is made a compile-time literal (``numba.literally``): each controller gets its own
+    specialised, cached kernel and the controller dispatch folds away.  ``log`` has shape
+    (n_rows, N_BASE_COLS + naux + 3); ``acc`` is the metrics accumulator; on failure the
+    state at the stop is copied into ``fail_state``.
     """
+    literally(code)
     nx = X0.shape[0]
     n_steps, log_every, ctrl_every = si[SI_NSTEPS], si[SI_LOG_EVERY], si[SI_CTRL_EVERY]
-    naux, nc = si[SI_NAUX], si[SI_NC]
+    naux = si[SI_NAUX]
     dt = sf[SF_DT]
     X = X0.copy()
     Xs = np.empty(nx)
-    K = np.zeros((4, nx))
-    hold = np.zeros(3 + nc)
-    tau1 = np.zeros(3)
-    tau = np.zeros(3)
-    aux1 = np.zeros(max(naux, 1))
-    aux = np.zeros(max(naux, 1))
+    k1, k2, k3, k4 = np.zeros(nx), np.zeros(nx), np.zeros(nx), np.zeros(nx)
+    hold = np.zeros(3 + nx - NX_PLANT)
+    tau1, tau = np.zeros(3), np.zeros(3)
+    aux1, aux = np.zeros(max(naux, 1)), np.zeros(max(naux, 1))
     refm = np.zeros((3, 3))
     omega = np.zeros(5)
     work = np.zeros(WORK_SIZE)
-    logwork = np.zeros(5)
-    e = np.zeros(3)
-    p1 = np.zeros(3)
     row = 0
     for k in range(n_steps + 1):
         t = k * dt
-        # controller sample (sampled-data mode): measured state, zero-order hold
-        if ctrl_every > 0 and k % ctrl_every == 0:
+        if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, hold
             eval_reference(ref_p, t, refm)
-            status = control(si[SI_CODE], t, X[0:5], X[5:10], X[10:], refm, vp_nom, cp, tau1, hold[3:], aux1, work)
+            eta, nu = plant_state(X)
+            status = control(code, t, eta, nu, X, refm, vp_nom, cp, tau1, k1, aux1, work)
             if status == 0 and not _finite3(tau1):
-                status = 3
+                status = STATUS_NONFINITE_INPUT
             if status != 0:
-                fail_state[:] = X
-                return CAUSE_CONTROLLER + status, row, t
-            for i in range(3):
-                hold[i] = tau1[i]
+                return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
+            hold[0], hold[1], hold[2] = tau1[0], tau1[1], tau1[2]
+            for i in range(NX_PLANT, nx):
+                hold[3 + i - NX_PLANT] = k1[i]
         # stage 1 at (t, X): also the values that are logged and enter the metrics
-        status = closed_loop_rhs(t, X, si, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, K[0], tau1, aux1, refm, omega, work)
+        status = closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold,
+                                 k1, tau1, aux1, refm, omega, work)
         if status == 0 and not _finite3(tau1):
-            status = 3
+            status = STATUS_NONFINITE_INPUT
         if status != 0:
-            fail_state[:] = X
-            return CAUSE_CONTROLLER + status, row, t
-        virtual_point(X[0:5], vp_nom[ELL], p1)
-        for i in range(3):
-            e[i] = p1[i] - refm[0, i]
+            return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
+        eta, nu = plant_state(X)
+        p1 = virtual_point(eta, attitude(eta[3], eta[4]), vp_nom[ELL])
+        e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
         if k % log_every == 0 and row < log.shape[0]:
-            _log_row(log[row], t, X, tau1, refm, e, aux1, naux, K[0, 5:10], vp_nom, omega, logwork)
+            _log_row(log, row, t, X, tau1, refm, e, aux1, naux, k1, vp_nom)
             row += 1
         if k == n_steps:
             break
-        metrics_update(acc, t, dt, e, tau1, sf[SF_WIN_T0], sf[SF_WIN_T1])
-        # stages 2-4
+        metrics_update(acc, t, dt, e, (tau1[0], tau1[1], tau1[2]), sf[SF_WIN_T0], sf[SF_WIN_T1])
         for i in range(nx):
-            Xs[i] = X[i] + 0.5 * dt * K[0, i]
-        status = closed_loop_rhs(t + 0.5 * dt, Xs, si, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, K[1], tau, aux, refm, omega, work)
+            Xs[i] = X[i] + 0.5 * dt * k1[i]
+        status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
+                                 hold, k2, tau, aux, refm, omega, work)
         if status == 0:
             for i in range(nx):
-                Xs[i] = X[i] + 0.5 * dt * K[1, i]
-            status = closed_loop_rhs(t + 0.5 * dt, Xs, si, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, K[2], tau, aux, refm, omega, work)
+                Xs[i] = X[i] + 0.5 * dt * k2[i]
+            status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows,
+                                     d_cur, hold, k3, tau, aux, refm, omega, work)
         if status == 0:
             for i in range(nx):
-                Xs[i] = X[i] + dt * K[2, i]
-            status = closed_loop_rhs(t + dt, Xs, si, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, K[3], tau, aux, refm, omega, work)
+                Xs[i] = X[i] + dt * k3[i]
+            status = closed_loop_rhs(code, t + dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
+                                     hold, k4, tau, aux, refm, omega, work)
         if status != 0:
-            fail_state[:] = X
-            return CAUSE_CONTROLLER + status, row, t
+            return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
         for i in range(nx):
-            X[i] += dt / 6.0 * (K[0, i] + 2.0 * K[1, i] + 2.0 * K[2, i] + K[3, i])
+            X[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
         cause = _state_cause(X, sf[SF_THETA_LIM], sf[SF_STATE_LIM])
         if cause != CAUSE_NONE:
-            fail_state[:] = X
-            return cause, row, t + dt
+            return _fail(cause, X, fail_state), row, t + dt
     return CAUSE_NONE, row, n_steps * dt

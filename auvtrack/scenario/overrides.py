@@ -1,0 +1,216 @@
+"""``dotted.key=value`` overrides applied to a raw scenario dict before validation.
+
+* ``sim.dt=0.002``: the value is parsed as a TOML value (numbers, booleans, strings, arrays,
+  inline tables, ``inf``); a bare word such as ``ftsmc`` is read as the string ``"ftsmc"``.
+* List entries are addressed by index: ``disturbance.0.amplitude=2``, ``initial.eta.1=0.7``;
+  index ``len`` appends a new entry (``disturbance.1.kind=pulse``).
+* Kind switch: setting the ``kind`` of a section whose keys depend on it (``controller``,
+  ``reference``, each ``disturbance.<i>``) to a *different* kind resets that table to just
+  ``{kind = <new>}`` before the later overrides apply, so ``controller.kind=ftsmc`` works on a
+  file that sets fxtntsmc gains.  ``envelope.kind`` and ``estimator.kind`` select modes that
+  share their keys and never reset anything.
+"""
+from __future__ import annotations
+
+import copy
+import re
+import tomllib
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping, Sequence
+
+from .errors import ScenarioError, format_value
+
+__all__ = ["Override", "parse_overrides", "apply_overrides", "KIND_DEFAULTS"]
+
+Segment = str | int
+_SEGMENT = re.compile(r"^(?:[A-Za-z_][A-Za-z0-9_\-]*|\d+)$")
+_BARE_WORD = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-+]*$")
+
+# Sections whose keys depend on ``kind`` (path without indices) and their default kind
+# (None: the kind is required).
+KIND_DEFAULTS: dict[str, str | None] = {"controller": "fxtntsmc", "reference": "helix", "disturbance.#": None}
+
+
+@dataclass(frozen=True)
+class Override:
+    """One parsed override.
+
+    Attributes
+    ----------
+    text : str
+        The override as the user wrote it (for messages).
+    path : tuple of str or int
+        Key path; integers index arrays.
+    value : object
+        The new value.
+    """
+
+    text: str
+    path: tuple[Segment, ...]
+    value: Any
+
+    @property
+    def dotted(self) -> str:
+        """The key path joined with dots."""
+        return ".".join(str(s) for s in self.path)
+
+
+def _parse_path(key: str, text: str) -> tuple[Segment, ...]:
+    parts = key.strip().split(".")
+    for p in parts:
+        if not _SEGMENT.match(p):
+            raise ScenarioError(f"override {text!r}: bad key segment {p!r} (use dotted.key=value, "
+                                f"indices as numbers: disturbance.0.amplitude=2)")
+    if parts[0].isdigit():
+        raise ScenarioError(f"override {text!r}: a key cannot start with an index")
+    return tuple(int(p) if p.isdigit() else p for p in parts)
+
+
+def parse_value(text: str) -> Any:
+    """Parse the right-hand side of an override as a TOML value (bare words are strings).
+
+    Raises
+    ------
+    ValueError
+        The text is neither a TOML value nor a bare word.
+    """
+    try:
+        doc = tomllib.loads(f"v = {text}")
+    except tomllib.TOMLDecodeError as exc:
+        if _BARE_WORD.match(text):
+            return text
+        raise ValueError(f"not a TOML value ({exc})") from None
+    if set(doc) != {"v"}:
+        raise ValueError("not a single TOML value")
+    return doc["v"]
+
+
+def parse_overrides(overrides: Sequence[str] | Mapping[str, Any] | str | None) -> list[Override]:
+    """Parse ``["a.b=1", ...]`` or ``{"a.b": 1}`` into :class:`Override` records.
+
+    Parameters
+    ----------
+    overrides : sequence of str, mapping, str or None
+        ``"dotted.key=value"`` strings (a single string is one override) or a mapping
+        ``{dotted_key: value}`` whose values are used as given.
+
+    Returns
+    -------
+    list of Override
+        In the given order.
+
+    Raises
+    ------
+    ScenarioError
+        A malformed override (no ``=``, empty key, bad segment, unparseable value).
+    """
+    if overrides is None:
+        return []
+    if isinstance(overrides, str):
+        overrides = [overrides]
+    out: list[Override] = []
+    if isinstance(overrides, Mapping):
+        for key, value in overrides.items():
+            text = f"{key}={format_value(value)}"
+            if not isinstance(key, str) or not key.strip():
+                raise ScenarioError(f"override {text!r}: the key must be a non-empty dotted string")
+            out.append(Override(text, _parse_path(key, text), copy.deepcopy(value)))
+        return out
+    for item in overrides:
+        if not isinstance(item, str):
+            raise ScenarioError(f"override {format_value(item)}: must be a string 'dotted.key=value'")
+        text = item.strip()
+        key, sep, raw = text.partition("=")
+        if not sep or not key.strip():
+            raise ScenarioError(f"override {text!r}: expected dotted.key=value (e.g. sim.dt=0.002)")
+        raw = raw.strip()
+        if not raw:
+            raise ScenarioError(f"override {text!r}: missing value after '='")
+        try:
+            value = parse_value(raw)
+        except ValueError as exc:
+            tip = "; quote strings with spaces (name=\"my run\")" if " " in raw else ""
+            raise ScenarioError(f"override {text!r}: value {raw!r} is {exc}{tip}") from None
+        out.append(Override(text, _parse_path(key, text), value))
+    return out
+
+
+def _pattern(path: Sequence[Segment]) -> str:
+    return ".".join("#" if isinstance(s, int) else str(s) for s in path)
+
+
+def apply_overrides(data: Mapping[str, Any], overrides: Sequence[Override],
+                    default_at: Callable[[dict, tuple[Segment, ...]], Any]) -> dict[str, Any]:
+    """Return a deep copy of ``data`` with ``overrides`` applied in order.
+
+    Parameters
+    ----------
+    data : mapping
+        Raw scenario (as read from TOML).
+    overrides : sequence of Override
+        Parsed overrides.
+    default_at : callable
+        ``default_at(data, path)`` returns the effective default value at ``path`` (used when
+        an override indexes into an array the file does not spell out), or None.
+
+    Returns
+    -------
+    dict
+        The modified copy; ``data`` is left untouched.
+
+    Raises
+    ------
+    ScenarioError
+        An override that walks through a non-table or indexes out of range.
+    """
+    out = copy.deepcopy(dict(data))
+    for ov in overrides:
+        _apply_one(out, ov, default_at)
+    return out
+
+
+def _apply_one(root: dict, ov: Override, default_at: Callable[[dict, tuple[Segment, ...]], Any]) -> None:
+    node: Any = root
+    path = ov.path
+    for depth, seg in enumerate(path[:-1]):
+        where = ".".join(str(s) for s in path[: depth + 1])
+        nxt = path[depth + 1]
+        if isinstance(node, dict) and isinstance(seg, str):
+            if node.get(seg) is None:
+                default = default_at(root, path[: depth + 1]) if isinstance(nxt, int) else None
+                node[seg] = copy.deepcopy(default) if default is not None else ([] if isinstance(nxt, int) else {})
+            node = node[seg]
+        elif isinstance(node, list) and isinstance(seg, int):
+            if seg == len(node):
+                node.append({} if isinstance(nxt, str) else [])
+            elif seg > len(node):
+                raise ScenarioError(f"override {ov.text!r}: {where}: index out of range "
+                                    f"(it has {len(node)} entries; index {len(node)} appends one)")
+            node = node[seg]
+        else:
+            kind = "an array (use an index)" if isinstance(node, list) else \
+                "a table (use a key)" if isinstance(node, dict) else f"a value ({format_value(node)})"
+            raise ScenarioError(f"override {ov.text!r}: {'.'.join(str(s) for s in path[:depth])  or 'scenario'} "
+                                f"is {kind}")
+        if not isinstance(node, (dict, list)):
+            raise ScenarioError(f"override {ov.text!r}: {where} is a value ({format_value(node)}), "
+                                f"not a table or array")
+    last = path[-1]
+    parent = path[:-1]
+    if last == "kind" and isinstance(node, dict) and _pattern(parent) in KIND_DEFAULTS:
+        current = node.get("kind", KIND_DEFAULTS[_pattern(parent)])
+        if ov.value != current:  # kind switch: drop the keys of the old kind
+            node.clear()
+    if isinstance(node, dict) and isinstance(last, str):
+        node[last] = copy.deepcopy(ov.value)
+    elif isinstance(node, list) and isinstance(last, int):
+        if last == len(node):
+            node.append(copy.deepcopy(ov.value))
+        elif last < len(node):
+            node[last] = copy.deepcopy(ov.value)
+        else:
+            raise ScenarioError(f"override {ov.text!r}: {ov.dotted}: index out of range "
+                                f"(it has {len(node)} entries; index {len(node)} appends one)")
+    else:
+        kind = "an array (use an index)" if isinstance(node, list) else "a table (use a key)"
+        raise ScenarioError(f"override {ov.text!r}: {'.'.join(str(s) for s in parent) or 'scenario'} is {kind}")

@@ -1,0 +1,395 @@
+"""Validated scenario model (pydantic v2): one frozen model per TOML section.
+
+Every key has a default reproducing the paper's Section 4 (with the ERRATA corrections), so an
+empty scenario *is* the paper scenario.  Every model forbids unknown keys.  Numbers are strict:
+a quoted ``"0.1"`` is not a number and ``true`` is not 1.  See ``docs/scenarios.md`` for the
+table of keys, units and ranges.
+"""
+from __future__ import annotations
+
+import math
+import typing
+from typing import Annotated, Any, Literal, Mapping, Union
+
+from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_validator,
+                      model_validator)
+
+from ..control.params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
+from ..plant.presets import available, get_preset
+from .components import check_disturbances, check_reference, jsonable
+from .errors import format_value
+
+__all__ = [
+    "CONTROLLER_MODELS", "ControllerParams", "Scenario", "SimSection", "VehicleSection",
+    "UncertaintySection", "InitialSection", "EnvelopeSection", "EstimatorSection",
+    "MetricsSection", "OutputSection",
+]
+
+# --- strict scalar types ------------------------------------------------------------------------
+Num = Annotated[float, Strict(), AllowInfNan(False)]  # finite; int accepted, str/bool refused
+Pos = Annotated[Num, Field(gt=0)]
+NonNeg = Annotated[Num, Field(ge=0)]
+Int = Annotated[int, Strict()]
+Bool = Annotated[bool, Strict()]
+Str = Annotated[str, Strict()]
+Vec3 = tuple[Num, Num, Num]
+Vec5 = tuple[Num, Num, Num, Num, Num]
+Pos3 = tuple[Pos, Pos, Pos]
+Pos5 = tuple[Pos, Pos, Pos, Pos, Pos]
+NonNeg5 = tuple[NonNeg, NonNeg, NonNeg, NonNeg, NonNeg]
+Range2 = tuple[Num, Num]
+Fraction = Annotated[Num, Field(ge=-0.9, le=2.0)]
+Open01 = Annotated[Num, Field(gt=0, lt=1)]
+
+# Controllers selectable by ``[controller] kind``: one parameter model per registered controller
+# (auvtrack.control registers the same models).  To add a controller, append its model here.
+CONTROLLER_MODELS: tuple[type[BaseModel], ...] = (FXTNTSMCParams, FTSMCParams, OpenLoopParams)
+ControllerParams = Annotated[Union[CONTROLLER_MODELS], Field(discriminator="kind")]  # type: ignore[valid-type]
+DEFAULT_CONTROLLER = "fxtntsmc"
+_CONTROLLER_BY_KIND = {m.model_fields["kind"].default: m for m in CONTROLLER_MODELS}
+
+MULTIPLE_RTOL = 1e-9
+
+
+def is_multiple(value: float, step: float) -> bool:
+    """True when ``value`` is a positive integer multiple of ``step`` within 1e-9 relative."""
+    n = round(value / step)
+    return n >= 1 and abs(n * step - value) <= MULTIPLE_RTOL * value
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def _broadcast3(value: Any) -> Any:
+    """A scalar number becomes three equal numbers; anything else is left to validation."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return (value, value, value)
+    return value
+
+
+class SimSection(_Section):
+    """``[sim]``: time grid, control sampling and divergence guards."""
+
+    duration: Pos = Field(100.0, description="simulated time, s")
+    dt: Annotated[Num, Field(gt=0, le=0.1)] = Field(0.001, description="RK4 step, s")
+    log_dt: Pos = Field(0.01, description="logging interval, s (integer multiple of dt)")
+    control_rate: NonNeg = Field(0.0, description="Hz; 0 = continuous (every RK4 stage)")
+    theta_limit: Annotated[Num, Field(gt=0, lt=90)] = Field(85.0, description="|pitch| stop, deg")
+    state_limit: Pos = Field(1e6, description="abs bound on every state before divergence")
+    integrator: Literal["rk4"] = "rk4"
+
+    @model_validator(mode="after")
+    def _grid(self) -> "SimSection":
+        if self.dt > self.duration:
+            raise ValueError(f"dt: must be <= duration = {self.duration:g} s (got {self.dt:g})")
+        if not is_multiple(self.duration, self.dt):
+            raise ValueError(f"duration: must be an integer multiple of dt = {self.dt:g} s (got {self.duration:g})")
+        if self.log_dt < self.dt:
+            raise ValueError(f"log_dt: must be >= dt = {self.dt:g} s (got {self.log_dt:g})")
+        if not is_multiple(self.log_dt, self.dt):
+            raise ValueError(f"log_dt: must be an integer multiple of dt = {self.dt:g} s (got {self.log_dt:g})")
+        if self.control_rate > 0 and not is_multiple(1.0 / self.control_rate, self.dt):
+            raise ValueError(f"control_rate: 1/control_rate must be an integer multiple of dt = {self.dt:g} s "
+                             f"(got {self.control_rate:g} Hz, period {1.0 / self.control_rate:g} s)")
+        return self
+
+    @property
+    def n_steps(self) -> int:
+        """Number of RK4 steps."""
+        return round(self.duration / self.dt)
+
+    @property
+    def log_every(self) -> int:
+        """Steps between two logged rows."""
+        return round(self.log_dt / self.dt)
+
+    @property
+    def control_every(self) -> int:
+        """Steps between two controller updates (0 = continuous)."""
+        return 0 if self.control_rate == 0 else round(1.0 / self.control_rate / self.dt)
+
+
+_VEHICLE_FIELDS = ("m", "d", "wgml", "l")
+
+
+class VehicleSection(_Section):
+    """``[vehicle]``: a preset and optional overrides of its numbers.
+
+    After validation ``m``, ``d``, ``wgml`` and ``l`` always hold the *effective* numbers
+    (preset values filled in where no override is given); :meth:`resolve` reports each
+    number's source.
+    """
+
+    preset: Str = Field("paper", description="one of auvtrack.plant.presets.available()")
+    m: Pos5 | None = Field(None, description="m11, m22, m33 (kg), m44, m55 (kg m^2)")
+    d: NonNeg5 | None = Field(None, description="d11, d22, d33 (N s/m), d44, d55 (N m s/rad)")
+    wgml: NonNeg | None = Field(None, description="rho g nabla GM_L, N m")
+    l: Annotated[Num, Field(gt=0, le=10)] | None = Field(  # noqa: E741 - paper's symbol
+        None, description="virtual-point offset ell, m (ell = 0 makes J3 singular)")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _fill_from_preset(cls, data: Any) -> Any:
+        if not isinstance(data, Mapping):
+            return data  # pydantic reports "must be a table"
+        name = data.get("preset", "paper")
+        if not isinstance(name, str):
+            raise ValueError(f"preset: must be a string (got {format_value(name)})")
+        names = available()
+        if name not in names:
+            raise ValueError(f"preset: unknown preset (allowed: {', '.join(names)}) (got {name!r})")
+        pre = get_preset(name)
+        out = dict(data)
+        for key in _VEHICLE_FIELDS:
+            if out.get(key) is None:
+                out[key] = getattr(pre, key)
+        return out
+
+    def resolve(self) -> dict[str, Any]:
+        """Effective vehicle numbers with the unit and source of each.
+
+        Returns
+        -------
+        dict
+            ``preset``, ``description``, ``m``, ``d``, ``wgml``, ``l`` and ``sources``:
+            per number ``{"unit", "source", "origin"}`` with ``origin`` ``"preset"`` or
+            ``"scenario"`` (an override differing from the preset value).
+        """
+        pre = get_preset(self.preset)
+        out: dict[str, Any] = {"preset": pre.name, "description": pre.description}
+        sources: dict[str, dict[str, str]] = {}
+        for key in _VEHICLE_FIELDS:
+            value, preset_value = getattr(self, key), getattr(pre, key)
+            from_preset = value == preset_value
+            out[key] = list(value) if isinstance(value, tuple) else value
+            sources[key] = {
+                "unit": pre.sources[key]["unit"],
+                "source": pre.sources[key]["source"] if from_preset
+                else f"scenario override (preset {pre.name!r} has {format_value(preset_value)})",
+                "origin": "preset" if from_preset else "scenario",
+            }
+        out["sources"] = sources
+        return out
+
+
+class UncertaintySection(_Section):
+    """``[uncertainty]``: fractional errors of the TRUE plant w.r.t. the controller's nominal model."""
+
+    C: Fraction = Field(0.1, description="Delta C / C0 (Section 4: 10 %)")
+    D: Fraction = Field(0.1, description="Delta D / D0 (Section 4: 10 %)")
+    M: Fraction = Field(0.0, description="Delta M / M")
+    G: Fraction = Field(0.0, description="Delta wgml / wgml")
+
+
+class InitialSection(_Section):
+    """``[initial]``: initial state eta(0) = [x, y, z, theta, psi], nu(0) = [u, v, w, q, r]."""
+
+    eta: Vec5 = Field((0.0, 0.5, 0.0, 0.0, 0.0), description="m, m, m, rad, rad")
+    nu: Vec5 = Field((0.0, 0.0, 0.0, 0.0, 0.0), description="m/s, m/s, m/s, rad/s, rad/s")
+
+    @field_validator("eta")
+    @classmethod
+    def _pitch(cls, eta: tuple[float, ...]) -> tuple[float, ...]:
+        if not abs(eta[3]) < math.pi / 2:
+            raise ValueError(f"3: pitch theta must satisfy |theta| < pi/2 rad (90 deg) (got {eta[3]:g})")
+        return eta
+
+
+class EnvelopeSection(_Section):
+    """``[envelope]``: prescribed-performance envelope of the fxtntsmc (eq. 20-25, ERRATA 7-10)."""
+
+    kind: Literal["none", "rigid", "reactive", "proactive"] = "proactive"
+    rho0: Pos3 = Field((5.0, 0.5, 0.2), description="initial baseline envelope, m")
+    rho_inf: Pos3 = Field((0.005, 0.005, 0.005), description="steady-state envelope, m")
+    T: Pos = Field(15.0, description="baseline settling time, s")
+    delta: Pos = Field(2.0, description="risk-monitor gain of eq. (21)")
+    epsilon: Pos = Field(0.1, description="transition width of gamma in eq. (22)")
+    lambda1: Pos = Field(0.5, description="adjustment decay rate, 1/s")
+    lambda2: Pos = Field(0.3, description="adjustment growth gain, m/s")
+    lambda3: Pos = Field(0.1, description="tanh scale of eq. (25)")
+    xi0: Open01 = Field(0.9, description="target |e/rho| at t = 0 after widening")
+    widen_start: Bool = Field(True, description="widen the envelope at a start on/outside it")
+    reactive_threshold: Open01 = Field(0.8, description="|xi| at which 'reactive' acts fully")
+    baseline: Literal["corrected", "printed"] = "corrected"
+
+    @field_validator("rho0", "rho_inf", mode="before")
+    @classmethod
+    def _broadcast(cls, v: Any) -> Any:
+        return _broadcast3(v)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "EnvelopeSection":
+        for i, (r0, ri) in enumerate(zip(self.rho0, self.rho_inf)):
+            if not ri < r0:
+                raise ValueError(f"rho_inf.{i}: must be < rho0.{i} = {r0:g} (got {ri:g})")
+        return self
+
+
+class EstimatorSection(_Section):
+    """``[estimator]``: RBF network estimating the lumped disturbance (eq. 11-13, 33-34)."""
+
+    kind: Literal["none", "printed", "omega"] = "omega"
+    # the engine's upper limit (scratch size) is checked by auvtrack.control.fxtntsmc.setup
+    neurons: Annotated[Int, Field(ge=1)] = 7
+    width: Pos = Field(1.0, description="Gaussian width b")
+    centre_range: Range2 = Field((-1.0, 1.0), description="centres drawn uniformly in [lo, hi]")
+    weight_range: Range2 = Field((0.0, 1.0), description="initial weights uniform in [lo, hi]")
+
+    @field_validator("centre_range")
+    @classmethod
+    def _centre(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if not v[0] < v[1]:
+            raise ValueError(f"must satisfy lo < hi (got {format_value(v)})")
+        return v
+
+    @field_validator("weight_range")
+    @classmethod
+    def _weight(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if not v[0] <= v[1]:
+            raise ValueError(f"must satisfy lo <= hi (got {format_value(v)})")
+        return v
+
+
+def _window(value: Any) -> tuple[float, float]:
+    """Parse ``[t0]``, ``[t0, t1]`` with t1 a number, ``inf``, ``"inf"`` or null (= inf)."""
+    if not isinstance(value, (list, tuple)):
+        raise ValueError(f"must be an array [t0, t1] (got {format_value(value)})")
+    if not 1 <= len(value) <= 2:
+        raise ValueError(f"must have 1 or 2 items [t0, t1] (got {len(value)})")
+    items = list(value) + [math.inf] * (2 - len(value))
+    if items[1] is None or (isinstance(items[1], str) and items[1].strip().lower() in ("inf", "+inf")):
+        items[1] = math.inf
+    for i, x in enumerate(items):
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or math.isnan(x):
+            raise ValueError(f"{i}: must be a number (got {format_value(x)})")
+    t0, t1 = float(items[0]), float(items[1])
+    if not (math.isfinite(t0) and t0 >= 0):
+        raise ValueError(f"0: must be a finite number >= 0 (got {format_value(t0)})")
+    if not t1 > t0:
+        raise ValueError(f"1: must be > t0 = {t0:g} (got {format_value(t1)})")
+    return t0, t1
+
+
+class MetricsSection(_Section):
+    """``[metrics]``: time window [t0, t1] (s) over which the metrics are computed."""
+
+    window: tuple[float, float] = Field((0.0, math.inf), description="s; t1 may be inf")
+
+    @field_validator("window", mode="before")
+    @classmethod
+    def _parse(cls, v: Any) -> tuple[float, float]:
+        return _window(v)
+
+
+class OutputSection(_Section):
+    """``[output]``: optional extra outputs."""
+
+    mat: Bool = Field(False, description="also write trajectory.mat")
+
+
+def _check_numbers(model: type[BaseModel], data: dict) -> None:
+    """Refuse strings/booleans/non-finite values where ``model`` expects numbers.
+
+    The controller parameter models are lax (they would read ``"0.5"`` as 0.5); scenario
+    files are held to the same strictness as the other sections.
+    """
+    for name, value in data.items():
+        field = model.model_fields.get(name)
+        if field is None or name == "kind":
+            continue
+        ann = field.annotation
+        if typing.get_origin(ann) is tuple:
+            if isinstance(value, (list, tuple)):
+                for i, item in enumerate(value):
+                    _check_number(f"{name}.{i}", item)
+        elif ann in (float, int):
+            _check_number(name, value)
+
+
+def _check_number(path: str, value: Any) -> None:
+    if isinstance(value, (str, bool)):
+        raise ValueError(f"{path}: must be a number (got {format_value(value)})")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"{path}: must be a finite number (got {format_value(value)})")
+
+
+class Scenario(BaseModel):
+    """A complete, validated simulation scenario (frozen).
+
+    Build one with :func:`auvtrack.scenario.load_scenario`; ``Scenario()`` is the paper's
+    Section 4.  :meth:`to_dict` gives the fully resolved, JSON-serialisable form, and
+    ``load_scenario(s.to_dict()) == s``.
+
+    Attributes
+    ----------
+    name, description : str
+        Run name (folder ``runs/<name>``) and free text.
+    seed : int
+        Seed of every random stream.
+    sim, vehicle, uncertainty, initial, envelope, estimator, metrics, output : section models
+        The TOML sections of the same names.
+    reference : dict
+        Resolved reference spec (``kind`` and every field of that kind).
+    controller : FXTNTSMCParams, FTSMCParams or OpenLoopParams
+        Controller parameters, selected by ``kind``.
+    disturbance : list of dict
+        Resolved disturbance specs (summed); empty for none.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    name: Str = Field("paper", description="run name (folder runs/<name>)")
+    description: Str = ""
+    seed: Annotated[Int, Field(ge=0)] = Field(0, description="seed of every random stream")
+    sim: SimSection = Field(default_factory=SimSection)
+    vehicle: VehicleSection = Field(default_factory=VehicleSection)
+    uncertainty: UncertaintySection = Field(default_factory=UncertaintySection)
+    reference: dict[str, Any] = Field(default_factory=lambda: {"kind": "helix"}, validate_default=True)
+    initial: InitialSection = Field(default_factory=InitialSection)
+    controller: ControllerParams = Field(default_factory=FXTNTSMCParams)
+    envelope: EnvelopeSection = Field(default_factory=EnvelopeSection)
+    estimator: EstimatorSection = Field(default_factory=EstimatorSection)
+    disturbance: list[dict[str, Any]] = Field(default_factory=lambda: [{"kind": "paper"}],
+                                              validate_default=True)
+    metrics: MetricsSection = Field(default_factory=MetricsSection)
+    output: OutputSection = Field(default_factory=OutputSection)
+
+    @field_validator("name")
+    @classmethod
+    def _name(cls, v: str) -> str:
+        if not v.strip() or any(c in v for c in "/\\") or v in (".", ".."):
+            raise ValueError(f"must be a non-empty name without '/' or '\\' (got {v!r})")
+        return v
+
+    @field_validator("reference", mode="before")
+    @classmethod
+    def _reference(cls, v: Any) -> dict:
+        return check_reference(v)
+
+    @field_validator("disturbance", mode="before")
+    @classmethod
+    def _disturbance(cls, v: Any) -> list:
+        return check_disturbances(v)
+
+    @field_validator("controller", mode="before")
+    @classmethod
+    def _controller(cls, v: Any) -> Any:
+        if isinstance(v, Mapping):
+            v = dict(v)
+            v.setdefault("kind", DEFAULT_CONTROLLER)
+            if not isinstance(v["kind"], str):
+                raise ValueError(f"kind: must be a string (got {format_value(v['kind'])})")
+            model = _CONTROLLER_BY_KIND.get(v["kind"])
+            if model is not None:
+                _check_numbers(model, v)
+        return v
+
+    def to_dict(self) -> dict[str, Any]:
+        """Fully resolved, JSON-serialisable scenario.
+
+        Every default is filled, the vehicle numbers are the effective ones, tuples become
+        lists and an infinite value (``metrics.window[1]``) is written as the string ``"inf"``.
+        ``load_scenario(s.to_dict()) == s``.
+        """
+        return jsonable(self.model_dump(mode="python"))
