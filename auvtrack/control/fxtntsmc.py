@@ -18,8 +18,9 @@ The |z|^(a2-1) of S1_dot (ERRATA 12) is handled by ``surface``: "nonsingular" re
 sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the same device as
 eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
 
-Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels: rho, rho1, chi_hat, S,
-the trigger g of the envelope, per axis.
+Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels per axis: rho (envelope),
+rho1 (baseline envelope), chi_hat (estimate), S (sliding variable), g (envelope trigger) and
+z (transformed error).
 """
 from __future__ import annotations
 
@@ -36,7 +37,7 @@ from .tracking import error_state, input_for_accel, sign
 
 CODE = 2
 AXES = ("x", "y", "z")
-AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "S", "g") for a in AXES)
+AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "S", "g", "z") for a in AXES)
 
 # packed parameters
 K1, K2, K3, A1, A2, A3, A4, ALPHA, SIGMA, SURF, ZSW, ZFL = range(12)
@@ -105,7 +106,7 @@ def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
             chat = rbf.estimate_and_adapt(X, XC + 3 + i * m, m, work, S, gain, dX)
         work[ACC + i] = edd - chat
         dX[XC + i] = rbd
-        aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i] = rho, rho1, chat, S, g
+        aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, chat, S, g, z
     tau[0], tau[1], tau[2] = input_for_accel(att, nu, vp, f, (work[ACC], work[ACC + 1], work[ACC + 2]))
     return 0
 
