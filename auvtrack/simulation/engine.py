@@ -22,6 +22,7 @@ import numpy as np
 from numba import literally
 
 from .._jit import njit
+from ..control import ftsmc, fxtntsmc, open_loop
 from ..control.dispatch import NX_PLANT, WORK_SIZE, control
 from ..control.tracking import lumped_disturbance
 from ..environment import eval_disturbance
@@ -47,6 +48,7 @@ CAUSES = {
     CAUSE_STATE_LIMIT: "state limit exceeded (divergence, |state| > sim.state_limit)",
 }
 STATUS_NONFINITE_INPUT = 3
+assert (ftsmc.CODE, fxtntsmc.CODE, open_loop.CODE) == (1, 2, 3), "update run_kernel's branches"
 
 
 @njit
@@ -122,14 +124,32 @@ def _fail(status, X, fail_state):
     return status
 
 
-@njit
+@njit(nogil=True)
 def run_kernel(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state):
     """Integrate the closed loop of controller ``code``; return (cause, rows_logged, t_stop).
 
-    ``code`` is made a compile-time literal (``numba.literally``): each controller gets its own
-    specialised, cached kernel and the controller dispatch folds away.  ``log`` has shape
+    The one run-time switch on ``code``: each branch calls :func:`integrate` with a constant,
+    so every controller gets its own specialised, cached loop (registering a controller adds
+    one branch here and one in :mod:`auvtrack.control.dispatch`).  ``log`` has shape
     (n_rows, N_BASE_COLS + naux + 3); ``acc`` is the metrics accumulator; on failure the
     state at the stop is copied into ``fail_state``.
+    """
+    if code == 1:  # ftsmc.CODE (a literal: numba needs it in the source)
+        return integrate(1, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state)
+    if code == 2:  # fxtntsmc.CODE (a literal: numba needs it in the source)
+        return integrate(2, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state)
+    if code == 3:  # open_loop.CODE (a literal: numba needs it in the source)
+        return integrate(3, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state)
+    return CAUSE_CONTROLLER + 99, 0, 0.0
+
+
+@njit(nogil=True)
+def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state):
+    """The RK4 loop of :func:`run_kernel` for one controller; ``code`` is a compile-time literal.
+
+    ``numba.literally`` makes the controller dispatch fold away (a run-time switch per stage
+    costs ~0.3 us); calling this from Python directly would re-type it on every call (~0.1 s),
+    which is why :func:`run_kernel` is the entry point.
     """
     literally(code)
     nx = X0.shape[0]
