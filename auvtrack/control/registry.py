@@ -63,7 +63,23 @@ CONTROLLERS: dict[str, ControllerSpec] = {}
 
 
 def register(spec: ControllerSpec) -> ControllerSpec:
-    """Add ``spec`` to :data:`CONTROLLERS`; names and codes must be unique."""
+    """Add ``spec`` to :data:`CONTROLLERS`.
+
+    Parameters
+    ----------
+    spec : ControllerSpec
+        The registration record; its name and code must be unused.
+
+    Returns
+    -------
+    ControllerSpec
+        ``spec`` itself.
+
+    Raises
+    ------
+    ValueError
+        If the name or the code is already registered.
+    """
     if spec.name in CONTROLLERS or any(s.code == spec.code for s in CONTROLLERS.values()):
         raise ValueError(f"controller {spec.name!r} (code {spec.code}) is already registered")
     CONTROLLERS[spec.name] = spec
@@ -71,7 +87,23 @@ def register(spec: ControllerSpec) -> ControllerSpec:
 
 
 def get(name: str) -> ControllerSpec:
-    """Return the registered controller ``name``; raise ``KeyError`` naming the choices."""
+    """Return a registered controller.
+
+    Parameters
+    ----------
+    name : str
+        Controller kind, e.g. ``"fxtntsmc"``.
+
+    Returns
+    -------
+    ControllerSpec
+        Its registration record.
+
+    Raises
+    ------
+    KeyError
+        If ``name`` is not registered (the message names the choices).
+    """
     try:
         return CONTROLLERS[name]
     except KeyError:

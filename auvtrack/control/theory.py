@@ -166,10 +166,14 @@ def lemma1_time(m1: float, m2: float, n1: float, n2: float, gamma1: float) -> fl
 
     Parameters
     ----------
-    m1, n1 : float
-        Positive gains.
-    m2, n2 : float
-        Exponents, ``0 < m2 < 1 < n2``.
+    m1 : float
+        Positive gain of the ``V^m2`` term.
+    m2 : float
+        Exponent, ``0 < m2 < 1``.
+    n1 : float
+        Positive gain of the ``V^n2`` term.
+    n2 : float
+        Exponent, ``n2 > 1``.
     gamma1 : float
         Free constant of the lemma, ``0 < gamma1 < 1``.
 
@@ -188,16 +192,20 @@ def lemma1_time(m1: float, m2: float, n1: float, n2: float, gamma1: float) -> fl
 
 
 def lemma1_residual(m1: float, m2: float, n1: float, n2: float, m3: float, gamma1: float) -> float:
-    """Residual set of Lemma 1, eq. (7) corrected (ERRATA 15): ``V <= R`` with
+    """Residual set of Lemma 1, eq. (7) corrected (ERRATA 15).
+
+    The set is ``V <= R`` with
 
         R = min{ [m3 / (m1 (1 - gamma1))]^(1/m2), [m3 / (n1 (1 - gamma1))]^(1/n2) }.
 
     Parameters
     ----------
-    m1, m2, n1, n2, gamma1 : float
+    m1, m2, n1, n2 : float
         As in :func:`lemma1_time`.
     m3 : float
         Non-negative constant term of the inequality.
+    gamma1 : float
+        As in :func:`lemma1_time`.
 
     Returns
     -------

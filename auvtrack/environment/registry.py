@@ -29,6 +29,7 @@ def build_disturbance(spec: dict):
     Returns
     -------
     PaperDisturbance, Pulse or GaussMarkovCurrent
+        The validated component.
 
     Raises
     ------

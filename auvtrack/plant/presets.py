@@ -54,7 +54,23 @@ def available() -> list[str]:
 
 
 def get_preset(name: str) -> VehiclePreset:
-    """Load preset ``name``; raise ``KeyError`` naming the available presets."""
+    """Load a vehicle preset from ``auvtrack/data/vehicles``.
+
+    Parameters
+    ----------
+    name : str
+        Preset name, e.g. ``"paper"``.
+
+    Returns
+    -------
+    VehiclePreset
+        The preset's numbers with their sources.
+
+    Raises
+    ------
+    KeyError
+        If there is no such preset (the message names the available ones).
+    """
     if name not in available():
         raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available()}")
     text = (resources.files("auvtrack") / "data" / "vehicles" / f"{name}.toml").read_text()

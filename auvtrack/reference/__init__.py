@@ -42,6 +42,7 @@ def build_reference(spec: dict) -> Reference:
     Returns
     -------
     Reference
+        The reference, with analytic first and second derivatives.
 
     Raises
     ------

@@ -34,8 +34,9 @@ def _harmonic(omega: float, radius: float, phase: float, center, climb: float):
 
 @dataclass(frozen=True, kw_only=True)
 class Helix(Reference):
-    """Helix about a vertical axis: ``x = cx + R cos(omega t + phase)``,
-    ``y = cy + R sin(omega t + phase)``, ``z = cz + climb t`` (NED, z down).
+    """Helix about a vertical axis (the Section 4 reference).
+
+    ``x = cx + R cos(omega t + phase)``, ``y = cy + R sin(omega t + phase)``, ``z = cz + climb t`` (NED, z down).
 
     Attributes
     ----------

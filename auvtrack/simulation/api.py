@@ -95,7 +95,24 @@ def _steps(value: float, dt: float, name: str) -> int:
 
 
 def prepare(scenario: Scenario) -> Prepared:
-    """Build every array the compiled engine needs from a validated scenario."""
+    """Build every array the compiled engine needs from a validated scenario.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A validated scenario (:func:`auvtrack.load_scenario`).
+
+    Returns
+    -------
+    Prepared
+        Packed float64 arrays, the logged channel names and the start-treatment notes.
+
+    Raises
+    ------
+    ValueError
+        If the controller refuses the set-up (e.g. a start on the envelope with the
+        treatment off), naming the field.
+    """
     sc = scenario
     vp_nom, vp_true, vehicle_record = vehicle_arrays(sc)
     ref = build_reference(dict(sc.reference))
@@ -125,7 +142,18 @@ def prepare(scenario: Scenario) -> Prepared:
 
 
 def run_prepared(prep: Prepared) -> Result:
-    """Run the compiled engine on prepared arrays and wrap the outcome in a :class:`Result`."""
+    """Run the compiled engine on prepared arrays and wrap the outcome in a :class:`Result`.
+
+    Parameters
+    ----------
+    prep : Prepared
+        The output of :func:`prepare`; it is not modified, so it can be run again.
+
+    Returns
+    -------
+    Result
+        The logged trajectory, metrics, status and (for a failed run) the failure record.
+    """
     log = np.full((prep.n_rows, len(prep.channels)), np.nan)
     acc = np.zeros(METRICS_SIZE)
     metrics_init(acc)

@@ -1,0 +1,91 @@
+"""Registry of ``auvtrack study NAME`` studies.
+
+A study is one module of :mod:`auvtrack.studies` that defines a module-level
+``STUDY = StudySpec(...)``.  :func:`all_studies` discovers every such module, so adding a study
+means adding one file; nothing else is edited.  Importing a study module must not compile or
+run anything.
+"""
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Protocol
+
+
+class StudyRunner(Protocol):
+    """Signature of a study's entry point."""
+
+    def __call__(self, out: Path, *, quick: bool = False, progress: bool = False) -> Path:
+        """Run the study, write its report and data under ``out``; return the report's path."""
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """Registration record of one study.
+
+    Attributes
+    ----------
+    name : str
+        Command-line name (``auvtrack study NAME``).
+    run : callable
+        ``run(out, *, quick=False, progress=False) -> Path`` (see :class:`StudyRunner`).
+    summary : str
+        One line shown by ``auvtrack study --help``.
+    """
+
+    name: str
+    run: Callable[..., Path]
+    summary: str = ""
+
+
+def all_studies() -> dict[str, StudySpec]:
+    """Discover every study module of :mod:`auvtrack.studies`.
+
+    Returns
+    -------
+    dict of str to StudySpec
+        ``{name: spec}`` in alphabetical order of the modules.
+
+    Raises
+    ------
+    ValueError
+        If two modules register the same study name.
+    """
+    from .. import studies as pkg
+
+    found: dict[str, StudySpec] = {}
+    for info in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda i: i.name):
+        mod = importlib.import_module(f"{pkg.__name__}.{info.name}")
+        spec = getattr(mod, "STUDY", None)
+        if isinstance(spec, StudySpec):
+            if spec.name in found:
+                raise ValueError(f"study {spec.name!r} is registered twice")
+            found[spec.name] = spec
+    return found
+
+
+def get_study(name: str) -> StudySpec:
+    """Return a registered study.
+
+    Parameters
+    ----------
+    name : str
+        Study name, e.g. ``"ablation"``.
+
+    Returns
+    -------
+    StudySpec
+        Its registration record.
+
+    Raises
+    ------
+    KeyError
+        If there is no such study (the message names the choices).
+    """
+    studies = all_studies()
+    try:
+        return studies[name]
+    except KeyError:
+        raise KeyError(f"unknown study {name!r}; choose one of {sorted(studies)}") from None

@@ -1,0 +1,94 @@
+"""The command line as a user meets it: outputs, exit codes, one-line errors, no tracebacks."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.io import loadmat
+
+from auvtrack.cli import EXIT_BAD_INPUT, EXIT_SIM_FAILED, main
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = ROOT / "scenarios" / "paper.toml"
+REQUIRED = ["t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r", "tau_u", "tau_q", "tau_r",
+            "xd", "yd", "zd", "ex", "ey", "ez", "rho_x", "rho_y", "rho_z", "chi_x", "chi_y", "chi_z",
+            "chi_hat_x", "chi_hat_y", "chi_hat_z"]
+
+
+def test_run_writes_the_run_folder_contract(tmp_path, capsys):
+    out = tmp_path / "fxt"
+    assert main(["run", str(PAPER), "--out", str(out), "--mat", "--set", "sim.duration=2"]) == 0
+    df = pd.read_csv(out / "trajectory.csv")
+    assert all(c in df.columns for c in REQUIRED)
+    assert len(df) == 201 and df["t"].iloc[-1] == pytest.approx(2.0)
+    run = json.loads((out / "run.json").read_text())
+    assert run["status"] == "ok" and run["failure"] is None
+    sc = run["scenario"]
+    for key in ("vehicle", "uncertainty", "disturbance", "reference", "initial", "controller", "sim", "seed"):
+        assert key in sc, key
+    assert sc["sim"]["dt"] == 0.001 and sc["controller"]["kind"] == "fxtntsmc"
+    assert "rmse_x" in run["metrics"] and "tv_tau_u" in run["metrics"]
+    mat = loadmat(out / "trajectory.mat")
+    np.testing.assert_allclose(mat["ex"].ravel(), df["ex"].to_numpy(), rtol=1e-12, atol=0)
+    err = capsys.readouterr().err
+    assert "widened" in err  # the Section 4 start treatment is announced, never silent
+
+
+def test_failed_run_exits_3_keeps_the_partial_result_and_says_why(tmp_path, capsys):
+    out = tmp_path / "tip"
+    code = main(["run", str(PAPER), "--out", str(out), "--set", "controller.kind=open_loop",
+                 "--set", "controller.tau0=[0, 200, 0]", "--set", "sim.duration=30"])
+    assert code == EXIT_SIM_FAILED
+    err = capsys.readouterr().err.strip().splitlines()
+    assert any(line.startswith("auvtrack: simulation failed at t = ") and "pitch" in line for line in err)
+    run = json.loads((out / "run.json").read_text())
+    assert run["status"] == "failed" and run["failure"]["cause"] == "pitch_limit"
+    df = pd.read_csv(out / "trajectory.csv")
+    assert 0 < len(df) < 3001 and df["t"].iloc[-1] <= run["failure"]["time"]
+
+
+@pytest.mark.parametrize("args, field", [
+    (["run", "no/such/file.toml"], "no/such/file.toml"),
+    (["run", str(PAPER), "--set", "vehicle.l=0"], "vehicle.l"),
+    (["check", str(PAPER), "--set", "sim.dt=0"], "sim.dt"),
+    (["bounds", str(PAPER), "--set", "controller.kind=ftsmc"], "controller.kind"),
+])
+def test_bad_input_is_one_line_with_status_2(args, field, capsys):
+    assert main(args) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("auvtrack: error:") and field in err
+    assert "Traceback" not in err
+
+
+def test_console_script_has_no_traceback_and_status_2():
+    p = subprocess.run([sys.executable, "-m", "auvtrack.cli", "run", str(PAPER), "--set", "sim.duration=-1"],
+                       capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == EXIT_BAD_INPUT
+    assert p.stderr.count("\n") == 1 and "sim.duration" in p.stderr and "Traceback" not in p.stderr
+
+
+def test_bounds_says_the_section4_guarantee_is_vacuous(capsys):
+    assert main(["bounds", str(PAPER)]) == 0
+    text = capsys.readouterr().out
+    assert "VACUOUS" in text and "T1  >=" in text
+    assert main(["bounds", str(PAPER), "--json"]) == 0
+    b = json.loads(capsys.readouterr().out)
+    assert b["T1"] > 283 and b["T1_is_lower_bound"] is True
+
+
+def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
+    from auvtrack.studies.reproduce import reproduce
+
+    summary = reproduce(tmp_path, quick=True)
+    for name in ("fig3_trajectory3d", "fig4_positions", "fig5_velocities", "fig6_inputs", "fig7_errors", "fig8_chi"):
+        assert (tmp_path / "figures" / f"{name}.png").stat().st_size > 10_000
+        assert (tmp_path / "figures" / f"{name}.pdf").exists()
+    m = json.loads((tmp_path / "metrics.json").read_text())
+    assert m["status"] == {"FXTNTSMC": "ok", "FTSMC": "ok"}
+    assert {v["verdict"] for v in m["verdicts"]} <= {"supported", "not supported", "mixed"}
+    assert len(m["verdicts"]) == 3 and "faster convergence" in summary
+    for kind in ("fxtntsmc", "ftsmc"):
+        assert (tmp_path / kind / "trajectory.csv").exists() and (tmp_path / kind / "run.json").exists()
