@@ -139,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
 
     warnings.simplefilter("default")
     try:
-        cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
+        rv = cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
     except click.exceptions.Exit as e:
         return e.exit_code
     except click.ClickException as e:
@@ -151,7 +151,8 @@ def main(argv: list[str] | None = None) -> int:
     except (ScenarioError, ValueError, KeyError, OSError) as e:
         click.echo(f"auvtrack: error: {_one_line(e)}", err=True)
         return EXIT_BAD_INPUT
-    return 0
+    # without standalone mode, click returns the code of a raised ``Exit`` instead of exiting
+    return rv if isinstance(rv, int) else 0
 
 
 if __name__ == "__main__":  # pragma: no cover
