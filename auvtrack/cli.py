@@ -1,4 +1,4 @@
-"""Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce``.
+"""Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce | study``.
 
 Bad input (a scenario error, a missing file, an invalid gain) prints ONE line to stderr and
 exits with status 2, never a traceback.  A simulation that fails (divergence, pitch limit,
@@ -106,10 +106,21 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 @click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: ftsmc, fxtntsmc).")
 @click.option("--repeat", default=7, show_default=True, help="Timed repetitions; the median is reported.")
 @click.option("--duration", default=20.0, show_default=True, help="Simulated seconds per repetition.")
-def bench(controllers: tuple[str, ...], repeat: int, duration: float) -> None:
+@click.option("--all", "run_all", is_flag=True,
+              help="Full suite: every controller, batch runs/s, sweep throughput on 1 and 2 Dask workers; "
+                   "writes benchmarks/results.{json,md} (or --out).")
+@click.option("--out", "bench_out", type=click.Path(file_okay=False), default=None,
+              help="Folder for the --all results (default: benchmarks/ of the source tree, else .).")
+def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
     """Time the compiled closed loop; one JSON line per controller with us_per_step."""
     from .studies.bench import bench_single
 
+    if run_all:
+        from .studies.bench import bench_all
+
+        doc = bench_all(repeat=repeat, out=Path(bench_out) if bench_out else None, progress=True)
+        click.echo(json.dumps(doc, indent=2))
+        return
     for kind in controllers or ("ftsmc", "fxtntsmc"):
         click.echo(json.dumps(bench_single(kind, repeat=repeat, duration=duration)))
 
@@ -123,6 +134,46 @@ def warmup() -> None:
 
 
 @cli.command()
+@click.argument("study")
+@click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default sweeps/<name>).")
+@click.option("--workers", type=int, default=None, help="Worker processes of the local Dask cluster (default: cores).")
+@click.option("--scheduler", default=None, metavar="ADDRESS", help="Use an existing Dask scheduler, tcp://host:port.")
+@click.option("--resume", is_flag=True, help="Finish an interrupted sweep in --out (completed chunks are kept).")
+@click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def sweep(study: str, out: str | None, workers: int | None, scheduler: str | None, resume: bool,
+          max_chunks: int | None, quiet: bool) -> None:
+    """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask."""
+    from .studies.sweep import run_sweep
+    from .studies.sweep_schema import load_study
+
+    if workers is not None and scheduler:
+        raise BadInput("--workers and --scheduler exclude each other (the scheduler's cluster has its workers)")
+    if workers is not None and workers < 1:
+        raise BadInput(f"--workers: must be >= 1 (got {workers})")
+    spec = load_study(study)
+    folder = Path(out) if out else Path("sweeps") / spec.study.name
+
+    def _stop(signum, frame):  # SIGTERM / SIGINT: stop cleanly (cluster closed, chunks kept for --resume)
+        raise KeyboardInterrupt
+
+    import signal
+
+    handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)}
+    try:
+        res = run_sweep(spec, folder, workers=workers, scheduler=scheduler, resume=resume, max_chunks=max_chunks,
+                        progress=not quiet)
+    finally:
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+    if res.complete:
+        click.echo((folder / "summary.md").read_text())
+        click.echo(f"written: {folder / 'results.parquet'}, {folder / 'summary.json'}, {folder / 'summary.md'}")
+    else:
+        click.echo(f"stopped after {res.chunks_run} chunks; finish with: auvtrack sweep {study} --out {folder} --resume")
+
+
+@cli.command()
 @click.option("--out", type=click.Path(file_okay=False), default="reproduce", show_default=True)
 @click.option("--quick", is_flag=True, help="Short horizon (smoke test).")
 def reproduce(out: str, quick: bool) -> None:
@@ -131,6 +182,37 @@ def reproduce(out: str, quick: bool) -> None:
 
     summary = _reproduce(Path(out), quick=quick, progress=True)
     click.echo(summary)
+
+
+class _StudyCommand(click.Command):
+    """``auvtrack study``: its ``--help`` lists the registered studies with their summaries."""
+
+    def format_epilog(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        from .studies.registry import all_studies
+
+        with formatter.section("Studies"):
+            formatter.write_dl([(n, s.summary) for n, s in sorted(all_studies().items())])
+        super().format_epilog(ctx, formatter)
+
+
+@cli.command(cls=_StudyCommand)
+@click.argument("name")
+@click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default studies/<NAME>).")
+@click.option("--quick", is_flag=True, help="CI-sized run (seconds instead of minutes).")
+def study(name: str, out: str | None, quick: bool) -> None:
+    """Run study NAME and write its report.md, results.json and figures (NAME 'list': list studies)."""
+    from .studies.registry import all_studies, get_study
+
+    if name == "list":
+        for n, spec in sorted(all_studies().items()):
+            click.echo(f"{n}: {spec.summary}")
+        return
+    try:
+        spec = get_study(name)
+    except KeyError as e:
+        raise BadInput(str(e.args[0])) from None
+    report = spec.run(Path(out) if out else Path("studies") / name, quick=quick, progress=True)
+    click.echo(f"report: {report}")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -33,7 +33,7 @@ def test_baseline_derivatives_by_finite_differences(t, rho0, rinf):
     if t > h:
         assert abs((rp - rm) / (2 * h) - d1) <= 1e-6 * max(1.0, abs(d1))
         assert abs((d1p - d1m) / (2 * h) - d2) <= 1e-5 * max(1.0, abs(d2))
-    assert rinf <= r <= rho0
+    assert rinf <= r <= rho0 * (1 + 4 * np.finfo(float).eps)  # (rho0 - rinf) + rinf may round up by an ulp
 
 
 def test_risk_indicator_is_c1_and_matches_eq22():

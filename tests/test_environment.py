@@ -198,13 +198,17 @@ def test_empty_list_is_zero():
 
 
 def test_one_compiled_specialisation_serves_every_combination():
+    seen = []
     for comps in ([], [PaperDisturbance()], [Pulse(start=0, duration=1, force=[1] * 5)],
                   [GaussMarkovCurrent()], [PaperDisturbance(), GaussMarkovCurrent()]):
         tab = pack_disturbances(comps, 2.0, 0)
         assert tab.rows.dtype == np.float64 and tab.rows.flags.c_contiguous and tab.rows.ndim == 2
         assert tab.current.dtype == np.float64 and tab.current.flags.c_contiguous
         tab.evaluate(0.5, vp=VP)
-    assert len(eval_disturbance.signatures) == 1
+        seen.append(frozenset(eval_disturbance.signatures))
+    # no combination adds a specialisation after the first one (the engine, if it was compiled
+    # earlier in this session, owns one more, typed with tuples: hence no absolute count)
+    assert len(set(seen)) == 1
 
 
 def test_unknown_kind_code_gives_nan():

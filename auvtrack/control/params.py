@@ -6,6 +6,9 @@ Theorem 1's stricter conditions are checked by :mod:`auvtrack.control.theory`.
 """
 from __future__ import annotations
 
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -20,7 +23,10 @@ class FTSMCParams(_Params):
 
     ``s = e + beta * sig^gamma(e_dot)`` with ``gamma = p/q`` in (1, 2); reaching law
     ``e_ddot = -(1/(beta*gamma)) sig^(2-gamma)(e_dot) - k1 sign(s) - k2 s``.
-    Defaults are the tuned gains recorded in ``docs/tuning.md``.
+    The defaults are hand-picked gains that predate the recorded tuning procedure; the gains
+    found by that procedure are the gain preset ``ftsmc_tuned`` (scenario key
+    ``controller.preset``, expanded into these fields when the scenario is loaded), see
+    ``docs/tuning.md`` for how the two compare.
     """
 
     kind: Literal["ftsmc"] = "ftsmc"
@@ -64,3 +70,83 @@ class FXTNTSMCParams(_Params):
     )
     z_switch: float = Field(0.01, gt=0, description="|z| below which the nonsingular switch is used")
     z_floor: float = Field(1e-6, gt=0, description="floor on |z| in the printed form's |z|^(a2-1)")
+
+
+# --------------------------------------------------------------------------- gain presets
+
+@dataclass(frozen=True)
+class GainPreset:
+    """Controller gains stored as data in ``auvtrack/data/gains/<name>.toml``.
+
+    Attributes
+    ----------
+    name : str
+        Preset name (the file name without ``.toml``).
+    kind : str
+        Controller kind the gains belong to (``"ftsmc"`` or ``"fxtntsmc"``).
+    description : str
+        One line: where the gains come from.
+    gains : dict of str to float
+        Scenario keys of ``[controller]`` and their values.
+    provenance : dict
+        How the gains were produced (study, optimiser, seed, budget, objective values).
+    """
+
+    name: str
+    kind: str
+    description: str
+    gains: dict
+    provenance: dict
+
+
+def _gains_root():
+    return resources.files("auvtrack") / "data" / "gains"
+
+
+def available_gain_presets() -> list[str]:
+    """Names of the gain presets shipped with the package.
+
+    Returns
+    -------
+    list of str
+        Sorted file names of ``auvtrack/data/gains/*.toml`` without the suffix.
+    """
+    root = _gains_root()
+    if not root.is_dir():
+        return []
+    return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
+
+
+def get_gain_preset(name: str) -> GainPreset:
+    """Load gain preset ``name``.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`available_gain_presets`.
+
+    Returns
+    -------
+    GainPreset
+        Kind, gains and provenance of the preset.
+
+    Raises
+    ------
+    KeyError
+        Unknown name (the message lists the available presets).
+    ValueError
+        A malformed preset file (missing ``kind`` or ``[gains]``, or a gain that is not a number).
+    """
+    names = available_gain_presets()
+    if name not in names:
+        raise KeyError(f"unknown gain preset {name!r}; choose one of {names}")
+    raw = tomllib.loads((_gains_root() / f"{name}.toml").read_text())
+    kind, gains = raw.get("kind"), raw.get("gains")
+    if not isinstance(kind, str) or not isinstance(gains, dict):
+        raise ValueError(f"gain preset {name!r}: needs a string 'kind' and a [gains] table")
+    for k, v in gains.items():
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise ValueError(f"gain preset {name!r}: gains.{k} must be a number (got {v!r})")
+    return GainPreset(name=name, kind=kind, description=str(raw.get("description", "")),
+                      gains={k: float(v) for k, v in gains.items()},
+                      provenance=dict(raw.get("provenance", {})))

@@ -2,7 +2,13 @@
 
 Presets live in ``auvtrack/data/vehicles/*.toml``; each number is a table with ``value``,
 ``unit`` and ``source`` so that ``run.json`` and the docs can cite where every parameter came
-from.  Use :func:`get_preset` to read one and :func:`pack_vehicle` to build the packed ``vp``
+from.  Registering a preset means adding its file: :func:`available` lists the files.  Shipped:
+
+* ``paper`` -- the torpedo AUV of the paper's Section 4 (ERRATA 5; partly assumed);
+* ``remus100`` -- the REMUS 100 (Prestero 2001) reduced to the diagonal 5-DOF form, damping
+  linearised at 1.5 m/s (reduction in ``docs/vehicles.md``).
+
+:data:`SHIPPED` names them; a test checks that each one is present and valid.  Use :func:`get_preset` to read one and :func:`pack_vehicle` to build the packed ``vp``
 array of :mod:`auvtrack.plant.params`.
 """
 from __future__ import annotations
@@ -16,6 +22,7 @@ import numpy as np
 from .params import CSCALE, D0, ELL, M0, VP_SIZE, WGML
 
 _FIELDS = ("m", "d", "wgml", "l")
+SHIPPED: tuple[str, ...] = ("paper", "remus100")
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,8 @@ from typing import Annotated, Any, Literal, Mapping, Union
 from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_validator,
                       model_validator)
 
-from ..control.params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
+from ..control.params import (FTSMCParams, FXTNTSMCParams, OpenLoopParams, available_gain_presets,
+                              get_gain_preset)
 from ..plant.presets import available, get_preset
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
@@ -314,6 +315,27 @@ def _check_number(path: str, value: Any) -> None:
         raise ValueError(f"{path}: must be a finite number (got {format_value(value)})")
 
 
+def _apply_gain_preset(v: dict) -> dict:
+    """Expand ``[controller] preset`` into the preset's gains (explicit keys win).
+
+    The ``preset`` key is consumed here: the validated (and resolved) scenario holds every
+    gain explicitly.  ``kind`` defaults to the preset's kind.
+    """
+    if "preset" not in v:
+        return v
+    name = v.pop("preset")
+    if not isinstance(name, str):
+        raise ValueError(f"preset: must be a string (got {format_value(name)})")
+    names = available_gain_presets()
+    if name not in names:
+        raise ValueError(f"preset: unknown gain preset (allowed: {', '.join(names) or 'none'}) (got {name!r})")
+    pre = get_gain_preset(name)
+    kind = v.get("kind", pre.kind)
+    if kind != pre.kind:
+        raise ValueError(f"preset: gain preset {name!r} is for kind {pre.kind!r} (got kind {format_value(kind)})")
+    return {**pre.gains, **v, "kind": kind}
+
+
 class Scenario(BaseModel):
     """A complete, validated simulation scenario (frozen).
 
@@ -376,7 +398,7 @@ class Scenario(BaseModel):
     @classmethod
     def _controller(cls, v: Any) -> Any:
         if isinstance(v, Mapping):
-            v = dict(v)
+            v = _apply_gain_preset(dict(v))
             v.setdefault("kind", DEFAULT_CONTROLLER)
             if not isinstance(v["kind"], str):
                 raise ValueError(f"kind: must be a string (got {format_value(v['kind'])})")

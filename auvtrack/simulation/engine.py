@@ -26,6 +26,7 @@ from ..control import ftsmc, fxtntsmc, open_loop
 from ..control.dispatch import NX_PLANT, WORK_SIZE, control
 from ..control.tracking import lumped_disturbance
 from ..environment import eval_disturbance
+from ..environment.layout import KIND_PAPER, KIND_PULSE
 from ..plant.dynamics import nu_dot
 from ..plant.kinematics import attitude, eta_dot, virtual_point
 from ..plant.params import ELL
@@ -59,11 +60,18 @@ def plant_state(X):
 
 @njit
 def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, dX, tau, aux,
-                    refm, omega, work):
-    """Write dX/dt; return 0 or a controller status.  ``hold`` = [tau (3), dxc] in sampled mode."""
+                    refm, omega, work, att, fresh):
+    """Write dX/dt; return 0 or a controller status.  ``hold`` = [tau (3), dxc] in sampled mode.
+
+    ``att`` is :func:`attitude` of X (the caller computes it once per stage).  With ``fresh``
+    false the reference ``refm`` and disturbance ``omega`` of the previous call are reused: the
+    engine passes false only for the second of two stages at the same time whose disturbance
+    does not depend on the state (RK4 stages 2 and 3), so the values are the same numbers.
+    """
     literally(code)
     eta, nu = plant_state(X)
-    eval_reference(ref_p, t, refm)
+    if fresh:
+        eval_reference(ref_p, t, refm)
     if ctrl_every == 0:
         status = control(code, t, eta, nu, X, refm, vp_nom, cp, tau, dX, aux, work)
         if status != 0:
@@ -72,12 +80,21 @@ def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_ro
         tau[0], tau[1], tau[2] = hold[0], hold[1], hold[2]
         for i in range(NX_PLANT, nx):
             dX[i] = hold[3 + i - NX_PLANT]
-    eval_disturbance(d_rows, d_cur, t, eta, nu, vp_true, omega)
-    att = attitude(eta[3], eta[4])
+    if fresh:
+        eval_disturbance(d_rows, d_cur, t, eta, nu, vp_true, omega)
     dX[0], dX[1], dX[2], dX[3], dX[4] = eta_dot(att, nu)
     dX[5], dX[6], dX[7], dX[8], dX[9] = nu_dot(att, nu, (tau[0], tau[1], tau[2]),
                                                (omega[0], omega[1], omega[2], omega[3], omega[4]), vp_true)
     return 0
+
+
+@njit
+def state_free_disturbance(d_rows):
+    """True when omega depends on time only (paper and pulse components), not on the state."""
+    for k in range(d_rows.shape[0]):
+        if d_rows[k, 0] != KIND_PAPER and d_rows[k, 0] != KIND_PULSE:
+            return False
+    return True
 
 
 @njit
@@ -101,14 +118,20 @@ def _log_row(log, row, t, X, tau, refm, e, aux, naux, dX, vp_nom):
 
 @njit
 def _state_cause(X, theta_lim, state_lim):
+    """Failure cause of a state (precedence: non-finite, pitch, state limit), one pass."""
+    nonfinite = over = False
     for i in range(X.shape[0]):
-        if not math.isfinite(X[i]):
-            return CAUSE_NONFINITE
+        x = X[i]
+        if not math.isfinite(x):
+            nonfinite = True
+        elif abs(x) > state_lim:
+            over = True
+    if nonfinite:
+        return CAUSE_NONFINITE
     if abs(X[3]) > theta_lim:
         return CAUSE_PITCH
-    for i in range(X.shape[0]):
-        if abs(X[i]) > state_lim:
-            return CAUSE_STATE_LIMIT
+    if over:
+        return CAUSE_STATE_LIMIT
     return CAUSE_NONE
 
 
@@ -165,6 +188,7 @@ def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, 
     refm = np.zeros((3, 3))
     omega = np.zeros(5)
     work = np.zeros(WORK_SIZE)
+    reuse = state_free_disturbance(d_rows)  # stage 3 may reuse stage 2's reference and omega
     row = 0
     for k in range(n_steps + 1):
         t = k * dt
@@ -180,14 +204,15 @@ def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, 
             for i in range(NX_PLANT, nx):
                 hold[3 + i - NX_PLANT] = k1[i]
         # stage 1 at (t, X): also the values that are logged and enter the metrics
+        att = attitude(X[3], X[4])
         status = closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold,
-                                 k1, tau1, aux1, refm, omega, work)
+                                 k1, tau1, aux1, refm, omega, work, att, True)
         if status == 0 and not _finite3(tau1):
             status = STATUS_NONFINITE_INPUT
         if status != 0:
             return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
         eta, nu = plant_state(X)
-        p1 = virtual_point(eta, attitude(eta[3], eta[4]), vp_nom[ELL])
+        p1 = virtual_point(eta, att, vp_nom[ELL])
         e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
         if k % log_every == 0 and row < log.shape[0]:
             _log_row(log, row, t, X, tau1, refm, e, aux1, naux, k1, vp_nom)
@@ -198,17 +223,17 @@ def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, 
         for i in range(nx):
             Xs[i] = X[i] + 0.5 * dt * k1[i]
         status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
-                                 hold, k2, tau, aux, refm, omega, work)
+                                 hold, k2, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True)
         if status == 0:
             for i in range(nx):
                 Xs[i] = X[i] + 0.5 * dt * k2[i]
             status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows,
-                                     d_cur, hold, k3, tau, aux, refm, omega, work)
+                                     d_cur, hold, k3, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), not reuse)
         if status == 0:
             for i in range(nx):
                 Xs[i] = X[i] + dt * k3[i]
             status = closed_loop_rhs(code, t + dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
-                                     hold, k4, tau, aux, refm, omega, work)
+                                     hold, k4, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True)
         if status != 0:
             return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
         for i in range(nx):

@@ -17,9 +17,23 @@ def paper_scenario_path() -> Path:
 
 
 def machine() -> dict:
-    """Short description of this machine for benchmark records."""
-    return {"python": platform.python_version(), "cpu": platform.processor() or platform.machine(),
-            "cores": os.cpu_count(), "system": platform.system()}
+    """Short description of this machine for benchmark records (CPU model, cores, load, versions)."""
+    import numba
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    try:
+        load = [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        load = None
+    return {"python": platform.python_version(), "cpu": cpu, "cores": os.cpu_count(), "system": platform.system(),
+            "numba": numba.__version__, "load_avg_1_5_15": load}
 
 
 def _prepared(kind: str, duration: float):
@@ -30,35 +44,88 @@ def _prepared(kind: str, duration: float):
 
 
 def bench_single(kind: str, *, repeat: int = 7, duration: float = 20.0) -> dict:
-    """Median wall time per RK4 step of one closed-loop run of the Section 4 scenario."""
+    """Median time per RK4 step of one closed-loop run of the Section 4 scenario.
+
+    Reports the wall time (``us_per_step``) and the CPU time of the running thread
+    (``cpu_us_per_step``), which is less disturbed by other processes on a shared machine.
+    """
     from ..simulation.api import run_prepared
 
     prep = _prepared(kind, duration)
     run_prepared(prep)  # compile or load from cache
-    times = []
+    times, cpu = [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.thread_time()
         res = run_prepared(prep)
+        cpu.append(time.thread_time() - c0)
         times.append(time.perf_counter() - t0)
     steps = int(prep.si[0])
     per = [1e6 * t / steps for t in times]
     return {"controller": kind, "us_per_step": round(statistics.median(per), 4),
-            "min_us_per_step": round(min(per), 4), "steps": steps, "repeat": repeat,
-            "status": res.status, "machine": machine()}
+            "min_us_per_step": round(min(per), 4),
+            "cpu_us_per_step": round(statistics.median(1e6 * t / steps for t in cpu), 4),
+            "steps": steps, "repeat": repeat, "status": res.status, "machine": machine()}
 
 
 def warmup() -> dict:
-    """Compile (or load from the on-disk cache) the kernels of every registered controller."""
+    """Compile (or load from the on-disk cache) every kernel, the batch kernels included.
+
+    Runs each registered controller's closed loop, its metrics-only (batch) form and the
+    ``prange`` batch kernel once on a 10 ms Section 4 run.
+
+    Returns
+    -------
+    dict
+        ``{"warmup_s": {kind: seconds, ..., "batch": seconds}}``.
+    """
     from ..control import CONTROLLERS
+    from ..simulation.api import run_prepared
+    from ..simulation.batch import run_batch
 
     out = {}
+    preps = []
     for kind in CONTROLLERS:
         t0 = time.perf_counter()
-        from ..simulation.api import run_prepared
-
-        run_prepared(_prepared(kind, 0.01))
+        prep = _prepared(kind, 0.01)
+        run_prepared(prep)
+        run_batch([prep], backend="serial")
+        preps.append(prep)
         out[kind] = round(time.perf_counter() - t0, 3)
+    t0 = time.perf_counter()
+    run_batch(preps, backend="prange")
+    out["batch"] = round(time.perf_counter() - t0, 3)
     return {"warmup_s": out}
 
 
-__all__ = ["bench_single", "warmup", "machine", "paper_scenario_path"]
+def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = False) -> dict:
+    """The full benchmark suite; writes ``results.json`` and ``results.md`` into ``out``.
+
+    Single-run µs per RK4 step for every controller, batch runs/s (10 s runs at dt = 1 ms) per
+    back end, and sweep throughput on 1 and 2 Dask workers (see
+    :mod:`auvtrack.studies.sweep_bench`).  ``out`` defaults to the source tree's ``benchmarks/``
+    when it exists, else the current folder.
+    """
+    from .sweep_bench import bench_batch, bench_breakdown, bench_sweep, write_results
+
+    say = print if progress else (lambda *a, **k: None)
+    mach = machine()  # load average before our own runs
+    single = []
+    for kind in ("open_loop", "ftsmc", "fxtntsmc"):
+        say(f"single run: {kind}")
+        single.append(bench_single(kind, repeat=repeat, duration=20.0))
+    say("breakdown")
+    breakdown = bench_breakdown(repeat=repeat)
+    say("batch")
+    batch = bench_batch(repeat=repeat)
+    say("sweep")
+    sweep = bench_sweep(repeat=max(3, repeat // 2))
+    doc = {"machine": mach, "repeat": repeat, "single": single, "breakdown": breakdown, "batch": batch,
+           "sweep": sweep}
+    if out is None:
+        tree = Path(__file__).resolve().parents[2] / "benchmarks"
+        out = tree if tree.is_dir() else Path.cwd()
+    write_results(doc, Path(out))
+    return doc
+
+
+__all__ = ["bench_single", "bench_all", "warmup", "machine", "paper_scenario_path"]

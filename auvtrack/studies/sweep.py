@@ -1,0 +1,325 @@
+"""``auvtrack sweep``: parameter sweeps and Monte Carlo studies on Dask distributed.
+
+The study (:mod:`auvtrack.studies.sweep_schema`) is cut into chunks of ``chunk_size`` samples;
+each chunk is one Dask task (:func:`auvtrack.studies.sweep_worker.run_chunk`) that runs its
+samples through the batch runner and returns an Arrow table.  The client writes each completed
+chunk as ``chunks/chunk-NNNNNN.parquet`` atomically (temporary file + rename), so
+
+* ``resume=True`` skips every chunk whose file exists and finishes with each sample once;
+* a worker that dies mid-chunk costs nothing: Dask reruns the task, and the task is pure;
+* a sample's row depends only on its index and the study, never on chunking or worker.
+
+At the end every chunk is combined into ``results.parquet`` (streamed, memory flat in the
+number of chunks) and a summary is written to ``summary.json`` and ``summary.md``.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import time
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from .sweep_schema import StudyError, StudySpec, load_study
+
+MANIFEST = "study.json"
+CHUNK_DIR = "chunks"
+RESULTS = "results.parquet"
+QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
+
+__all__ = ["run_sweep", "SweepOutcome", "chunk_path", "read_results", "summarize", "MANIFEST", "RESULTS"]
+
+
+@dataclass(frozen=True)
+class SweepOutcome:
+    """What :func:`run_sweep` did.
+
+    Attributes
+    ----------
+    out : Path
+        Output folder.
+    complete : bool
+        Every chunk has its file (False after ``max_chunks`` stopped the sweep early).
+    chunks_run, chunks_skipped : int
+        Chunks computed now, chunks found on disk (``resume``).
+    summary : dict or None
+        The summary (only when complete).
+    seconds : float
+        Wall time of the computation (excluding cluster start-up and warm-up).
+    """
+
+    out: Path
+    complete: bool
+    chunks_run: int
+    chunks_skipped: int
+    summary: dict | None
+    seconds: float
+
+
+def chunk_path(out: Path, chunk: int) -> Path:
+    """File of chunk ``chunk`` under ``out``."""
+    return Path(out) / CHUNK_DIR / f"chunk-{chunk:06d}.parquet"
+
+
+def _write_atomic_table(table, path: Path) -> None:
+    import pyarrow.parquet as pq
+
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    pq.write_table(table, tmp)
+    os.replace(tmp, path)
+
+
+def _write_atomic_text(text: str, path: Path) -> None:
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _manifest(spec: StudySpec) -> dict:
+    from .. import __version__
+    from .._jit import source_hash
+
+    return {"fingerprint": spec.fingerprint(), "name": spec.study.name, "source": spec.source,
+            "n_samples": spec.n_samples, "n_chunks": spec.n_chunks, "chunk_size": spec.study.chunk_size,
+            "study": spec.study.model_dump(mode="json"), "auvtrack_version": __version__,
+            "source_hash": source_hash()}
+
+
+def _prepare_out(spec: StudySpec, out: Path, resume: bool) -> set[int]:
+    """Create or check the output folder; return the chunks already done."""
+    (out / CHUNK_DIR).mkdir(parents=True, exist_ok=True)
+    man_path = out / MANIFEST
+    fp = spec.fingerprint()
+    done = {c for c in range(spec.n_chunks) if chunk_path(out, c).exists()}
+    if man_path.exists():
+        try:
+            old = json.loads(man_path.read_text())
+        except (OSError, ValueError):
+            old = {}
+        if old.get("fingerprint") != fp:
+            raise StudyError(f"--out: {out} holds a different study ({old.get('source', '?')}); "
+                             "choose another folder")
+        if done and not resume:
+            raise StudyError(f"--out: {out} already holds {len(done)} of {spec.n_chunks} chunks of this study; "
+                             "pass --resume to finish it or choose another folder")
+    elif done:
+        raise StudyError(f"--out: {out} holds chunk files but no {MANIFEST}; choose another folder")
+    _write_atomic_text(json.dumps(_manifest(spec), indent=2), man_path)
+    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp-*"):  # left by an interrupted write
+        stale.unlink(missing_ok=True)
+    return done
+
+
+def _client(workers: int | None, scheduler: str | None, memory_limit: str):
+    """(client, cluster or None): a LocalCluster of ``workers`` processes or an existing scheduler."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler), None
+    from ..simulation.batch import default_workers
+
+    n = default_workers() if workers is None else workers
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                           memory_limit=memory_limit, env={"NUMBA_NUM_THREADS": "1"}, silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | None = None,
+              scheduler: str | None = None, resume: bool = False, max_chunks: int | None = None,
+              progress: bool = True, client: Any = None, memory_limit: str = "1GiB",
+              on_chunk: Callable[[int, Any], None] | None = None) -> SweepOutcome:
+    """Run (or resume) a sweep on Dask and write its results under ``out``.
+
+    Parameters
+    ----------
+    study : str, Path or StudySpec
+        Study file or a loaded study.
+    out : str or Path
+        Output folder: ``study.json``, ``chunks/``, ``results.parquet``, ``summary.{json,md}``.
+    workers : int, optional
+        Worker processes of the LocalCluster started here (default: one per core).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:port``); no cluster is started.
+    resume : bool, optional
+        Continue a sweep in ``out``: chunks whose file exists are not run again.
+    max_chunks : int, optional
+        Stop after this many chunks have been written (the rest stay to ``resume``).
+    progress : bool, optional
+        Show a tqdm bar (samples done, rate, ETA).
+    client : distributed.Client, optional
+        Use this client (its cluster is left running); overrides ``workers``/``scheduler``.
+    memory_limit : str, optional
+        Per-worker memory limit of the LocalCluster.
+    on_chunk : callable, optional
+        ``on_chunk(chunks_written_now, client)`` after each chunk file is written (a hook for
+        tests and monitoring).
+
+    Returns
+    -------
+    SweepOutcome
+
+    Raises
+    ------
+    StudyError
+        Invalid study file or an output folder holding another study.
+    """
+    spec = study if isinstance(study, StudySpec) else load_study(study)
+    if workers is not None and workers < 1:
+        raise StudyError(f"--workers: must be >= 1 (got {workers})")
+    if max_chunks is not None and max_chunks < 1:
+        raise StudyError(f"max_chunks: must be >= 1 (got {max_chunks})")
+    out = Path(out)
+    done = _prepare_out(spec, out, resume)
+    todo = [c for c in range(spec.n_chunks) if c not in done]
+    own = client is None
+    cluster = None
+    seconds = 0.0
+    written = 0
+    if todo:
+        if own:
+            client, cluster = _client(workers, scheduler, memory_limit)
+        try:
+            written, seconds = _compute(spec, out, todo, client, max_chunks, progress, on_chunk,
+                                        n_done=sum(len(spec.chunk_range(c)) for c in done))
+        finally:
+            if own:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+    complete = all(chunk_path(out, c).exists() for c in range(spec.n_chunks))
+    summary = None
+    if complete:
+        combine(spec, out)
+        summary = summarize(out / RESULTS, spec)
+        summary["seconds"] = seconds
+        _write_atomic_text(json.dumps(summary, indent=2, default=_json_default), out / "summary.json")
+        _write_atomic_text(summary_markdown(summary), out / "summary.md")
+    return SweepOutcome(out, complete, written, len(done), summary, seconds)
+
+
+def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: int | None, progress: bool,
+             on_chunk, n_done: int) -> tuple[int, float]:
+    from dask.distributed import as_completed
+    from tqdm.auto import tqdm
+
+    from .sweep_worker import WarmupPlugin, run_chunk
+
+    client.register_plugin(WarmupPlugin(), name=WarmupPlugin.name)
+    token = f"{spec.fingerprint()[:12]}-{uuid.uuid4().hex[:8]}"  # fresh keys: never reuse cancelled tasks
+    t0 = time.perf_counter()
+    futures = [client.submit(run_chunk, spec, c, key=f"auvtrack-sweep-{token}-{c}", retries=1) for c in todo]
+    chunk_of = {f.key: c for f, c in zip(futures, todo)}
+    written = 0
+    bar = tqdm(total=spec.n_samples, initial=n_done, unit="sample", desc=spec.study.name, disable=not progress,
+               smoothing=0.1)
+    try:
+        for fut in as_completed(futures):
+            c = chunk_of[fut.key]
+            table = fut.result()
+            path = chunk_path(out, c)
+            if not path.exists():  # idempotent: a chunk is written once
+                _write_atomic_table(table, path)
+            fut.release()
+            written += 1
+            bar.update(table.num_rows)
+            if on_chunk is not None:
+                on_chunk(written, client)
+            if max_chunks is not None and written >= max_chunks:
+                break
+    finally:
+        bar.close()
+        pending = [f for f in futures if not f.done()]
+        if pending:
+            client.cancel(pending)
+    return written, time.perf_counter() - t0
+
+
+def combine(spec: StudySpec, out: Path) -> Path:
+    """Stream every chunk file, in chunk order, into ``out/results.parquet`` (atomic)."""
+    import pyarrow.parquet as pq
+
+    from .sweep_worker import result_schema
+
+    schema = result_schema(spec)
+    path = out / RESULTS
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    with pq.ParquetWriter(tmp, schema) as writer:
+        for c in range(spec.n_chunks):
+            writer.write_table(pq.read_table(chunk_path(out, c), schema=schema))
+    os.replace(tmp, path)
+    return path
+
+
+def read_results(out: str | Path):
+    """The combined results of a finished sweep as a pandas DataFrame (one row per sample)."""
+    import pandas as pd
+
+    return pd.read_parquet(Path(out) / RESULTS)
+
+
+def _json_default(x: Any) -> Any:
+    return float(x) if isinstance(x, (int, float)) else str(x)
+
+
+def _finite_or_none(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def summarize(results: Path, spec: StudySpec) -> dict:
+    """Counts, failure rate, causes and per-metric quantiles (over "ok" samples) of a results file."""
+    import numpy as np
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+
+    from ..simulation.metrics import METRIC_NAMES
+
+    status = pq.read_table(results, columns=["status", "cause"])
+    n = status.num_rows
+    counts = {k: int(v) for k, v in zip(*np.unique(status.column("status").to_numpy(zero_copy_only=False),
+                                                   return_counts=True))}
+    causes = {}
+    for k, v in zip(*np.unique(status.column("cause").to_numpy(zero_copy_only=False), return_counts=True)):
+        if k:
+            causes[str(k)] = int(v)
+    ok_mask = pc.equal(status.column("status"), "ok")
+    metrics: dict[str, dict] = {}
+    for name in METRIC_NAMES:
+        col = pq.read_table(results, columns=[name]).column(name).filter(ok_mask).to_numpy()
+        fin = col[np.isfinite(col)]
+        entry: dict[str, Any] = {"n_finite": int(fin.size), "n_inf": int(np.isinf(col).sum())}
+        if fin.size:
+            entry["mean"] = float(fin.mean())
+            entry["min"] = float(fin.min())
+            for q, v in zip(QUANTILES, np.quantile(fin, QUANTILES)):
+                entry[f"q{int(round(q * 100)):02d}"] = float(v)
+            entry["max"] = float(fin.max())
+        metrics[name] = entry
+    failed = counts.get("failed", 0)
+    invalid = counts.get("invalid", 0)
+    return {"study": spec.study.name, "source": spec.source, "samples": n, "counts": counts,
+            "failure_rate": failed / n if n else math.nan, "invalid_rate": invalid / n if n else math.nan,
+            "causes": causes, "varied": list(spec.varied), "quantile_levels": list(QUANTILES), "metrics": metrics}
+
+
+def summary_markdown(s: dict) -> str:
+    """Render a summary (from :func:`summarize`) as Markdown."""
+    lines = [f"# Sweep {s['study']}", "", f"Study file: `{s['source']}`; varied: "
+             f"{', '.join(f'`{k}`' for k in s['varied']) or 'nothing (replicates only)'}.", "",
+             f"Samples: {s['samples']} — " + ", ".join(f"{k}: {v}" for k, v in sorted(s["counts"].items())) +
+             f"; failure rate {s['failure_rate']:.2%}" + (f", invalid {s['invalid_rate']:.2%}" if s["invalid_rate"]
+                                                          else "") + ".", ""]
+    if s["causes"]:
+        lines += ["Failure causes: " + ", ".join(f"{k} ({v})" for k, v in sorted(s["causes"].items())) + ".", ""]
+    if "seconds" in s and s["seconds"]:
+        lines += [f"Computed in {s['seconds']:.1f} s.", ""]
+    qs = [f"q{int(round(q * 100)):02d}" for q in s["quantile_levels"]]
+    lines += ["Metric quantiles over the ok samples (finite values; `inf` = never settled):", "",
+              "| metric | n | inf | mean | " + " | ".join(qs) + " |", "|---" * (4 + len(qs)) + "|"]
+    for name, e in s["metrics"].items():
+        vals = [f"{e[k]:.4g}" if k in e else "–" for k in ["mean"] + qs]
+        lines.append(f"| {name} | {e['n_finite']} | {e['n_inf']} | " + " | ".join(vals) + " |")
+    return "\n".join(lines) + "\n"

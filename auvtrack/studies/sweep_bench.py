@@ -1,0 +1,202 @@
+"""Batch and sweep benchmarks of ``auvtrack bench --all`` (reported figures, never timed tests)."""
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+BATCH_RUNS = 40
+RUN_SECONDS = 10.0
+SWEEP_SAMPLES_PER_KIND = 60
+
+_STUDY = """
+name = "bench"
+scenario = "paper"
+set = ["sim.duration={duration}"]
+seed = 1
+samples = {samples}
+chunk_size = 10
+[grid]
+"controller.kind" = ["ftsmc", "fxtntsmc"]
+[random."uncertainty.D"]
+dist = "uniform"
+low = 0.0
+high = 0.3
+"""
+
+
+def _load() -> float | None:
+    """1-minute load average (other processes disturb the parallel figures)."""
+    try:
+        return round(os.getloadavg()[0], 2)
+    except OSError:
+        return None
+
+
+def _preps(kind: str, n: int, duration: float) -> list:
+    from ..scenario import load_scenario
+    from ..simulation.api import prepare
+    from .bench import paper_scenario_path
+
+    return [prepare(load_scenario(paper_scenario_path(), {"controller.kind": kind, "sim.duration": duration,
+                                                          "seed": i, "uncertainty.D": 0.005 * i}))
+            for i in range(n)]
+
+
+BREAKDOWN = (
+    ("engine alone (open_loop, three sines per stage)", {"controller.kind": "open_loop"}),
+    ("engine alone, no disturbance", {"controller.kind": "open_loop", "disturbance": []}),
+    ("ftsmc", {"controller.kind": "ftsmc"}),
+    ("fxtntsmc, no envelope, no RBF", {"envelope.kind": "none", "estimator.kind": "none"}),
+    ("fxtntsmc, rigid envelope, no RBF", {"envelope.kind": "rigid", "estimator.kind": "none"}),
+    ("fxtntsmc, proactive envelope, no RBF", {"estimator.kind": "none"}),
+    ("fxtntsmc, no envelope, RBF (7 neurons)", {"envelope.kind": "none"}),
+    ("fxtntsmc, proactive envelope, RBF (Section 4)", {}),
+    ("fxtntsmc Section 4, controller sampled at 100 Hz", {"sim.control_rate": 100.0}),
+)
+
+
+def bench_breakdown(*, repeat: int = 7, duration: float = 5.0) -> list[dict]:
+    """Where the time of one RK4 step goes: CPU µs per step of Section 4 variants (metrics only)."""
+    from ..scenario import load_scenario
+    from ..simulation.api import prepare
+    from ..simulation.batch import run_metrics
+    from .bench import paper_scenario_path
+
+    rows = []
+    for label, ov in BREAKDOWN:
+        prep = prepare(load_scenario(paper_scenario_path(), {"sim.duration": duration, **ov}))
+        run_metrics(prep)
+        cpu = []
+        for _ in range(repeat):
+            c0 = time.thread_time()
+            run_metrics(prep)
+            cpu.append(time.thread_time() - c0)
+        rows.append({"variant": label, "overrides": ov,
+                     "cpu_us_per_step": round(1e6 * statistics.median(cpu) / int(prep.si[0]), 3)})
+    return rows
+
+
+def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RUN_SECONDS) -> list[dict]:
+    """Runs per second of the batch runner for each controller and back end (metrics only).
+
+    Also reports the Python-side preparation time per run (scenario validation and packing),
+    which is not parallelised by the thread back ends.
+    """
+    from ..simulation.batch import default_workers, run_batch
+
+    rows = []
+    for kind in ("ftsmc", "fxtntsmc"):
+        t0 = time.perf_counter()
+        preps = _preps(kind, runs, duration)
+        prep_ms = 1e3 * (time.perf_counter() - t0) / runs
+        for backend in ("serial", "threads", "prange"):
+            run_batch(preps[:2], backend=backend)  # warm
+            rates = []
+            for _ in range(repeat):
+                t0 = time.perf_counter()
+                run_batch(preps, backend=backend)
+                rates.append(runs / (time.perf_counter() - t0))
+            rows.append({"controller": kind, "backend": backend, "runs": runs, "run_seconds": duration,
+                         "runs_per_s": round(statistics.median(rates), 2), "max_runs_per_s": round(max(rates), 2),
+                         "prepare_ms_per_run": round(prep_ms, 3), "cores": default_workers(), "repeat": repeat,
+                         "load_avg_1min": _load()})
+    return rows
+
+
+def bench_sweep(*, repeat: int = 3, workers: tuple[int, ...] = (1, 2), duration: float = RUN_SECONDS,
+                samples: int = SWEEP_SAMPLES_PER_KIND) -> list[dict]:
+    """Samples per second of ``auvtrack sweep`` on LocalClusters of 1 and 2 worker processes.
+
+    The clusters run side by side and their repetitions alternate, so a change in the machine's
+    load affects both alike; the parallel efficiency is the median over repetitions of
+    rate(n) / (n rate(1)).  Cluster start-up and worker warm-up are excluded (paid once per
+    sweep); the time covers submitting, computing and writing every chunk.
+    """
+    from contextlib import ExitStack
+
+    from dask.distributed import Client, LocalCluster
+
+    from .sweep import run_sweep
+    from .sweep_schema import load_study
+
+    with tempfile.TemporaryDirectory() as tmp, ExitStack() as stack:
+        study = Path(tmp) / "study.toml"
+        study.write_text(_STUDY.format(duration=duration, samples=samples))
+        spec = load_study(study)
+        clients = {}
+        for n in workers:
+            cluster = stack.enter_context(LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                                       dashboard_address=":0", memory_limit="1GiB",
+                                                       silence_logs=40))
+            clients[n] = stack.enter_context(Client(cluster))
+            run_sweep(spec, Path(tmp) / f"warm-{n}", client=clients[n], progress=False, max_chunks=1)
+        rates: dict[int, list[float]] = {n: [] for n in workers}
+        for r in range(repeat):
+            for n in workers:
+                res = run_sweep(spec, Path(tmp) / f"w{n}-{r}", client=clients[n], progress=False)
+                rates[n].append(spec.n_samples / res.seconds)
+        base = workers[0]
+        rows = []
+        for n in workers:
+            eff = [rn / (n / base * r1) for rn, r1 in zip(rates[n], rates[base])]
+            rows.append({"workers": n, "samples": spec.n_samples, "run_seconds": duration,
+                         "samples_per_s": round(statistics.median(rates[n]), 2),
+                         "max_samples_per_s": round(max(rates[n]), 2), "repeat": repeat,
+                         "parallel_efficiency": round(statistics.median(eff), 3), "load_avg_1min": _load()})
+    return rows
+
+
+def write_results(doc: dict, out: Path) -> None:
+    """Write ``results.json`` and ``results.md`` (medians and ratios) into ``out``."""
+    import datetime
+
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {"date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="minutes"), **doc}
+    (out / "results.json").write_text(json.dumps(doc, indent=2))
+    m = doc["machine"]
+    single = {r["controller"]: r for r in doc["single"]}
+    lines = ["# Benchmark results", "",
+             f"Measured {doc['date']} with `auvtrack bench --all` on {m['cpu']}, {m['cores']} cores, "
+             f"Python {m['python']}, Numba {m['numba']}; load average at the start {m['load_avg_1_5_15']} "
+             "(a shared, noisy machine: medians of "
+             f"{doc['repeat']} repetitions; the CPU-time column is less sensitive to other processes).", ""]
+    load = m.get("load_avg_1_5_15") or [0.0]
+    if load[0] > 0.5 * (m.get("cores") or 1):
+        lines += ["**The machine was not idle when the suite started** (1-minute load average above half the "
+                  "cores): other processes may have competed for the cores, inflating wall times and lowering "
+                  "the parallel figures (threads, prange, 2 workers); see the `load after` columns.", ""]
+    lines += [
+             "## Single run (Section 4, 20 s at dt = 1 ms, controller at every RK4 stage, one core)", "",
+             "| controller | median wall µs / RK4 step | min wall µs / step | median CPU µs / step |",
+             "|---|---|---|---|"]
+    lines += [f"| {r['controller']} | {r['us_per_step']:.2f} | {r['min_us_per_step']:.2f} | "
+              f"{r['cpu_us_per_step']:.2f} |" for r in doc["single"]]
+    lines += ["", f"FXTNTSMC / FTSMC: {single['fxtntsmc']['cpu_us_per_step'] / single['ftsmc']['cpu_us_per_step']:.2f} "
+              f"(CPU time); open_loop is the engine alone (plant, reference, disturbance, metrics) plus three sines.",
+              ""]
+    if doc.get("breakdown"):
+        lines += ["## Where the time goes (median CPU µs per RK4 step, metrics only, 5 s runs)", "",
+                  "| variant | CPU µs / step |", "|---|---|"]
+        lines += [f"| {r['variant']} | {r['cpu_us_per_step']:.2f} |" for r in doc["breakdown"]]
+        lines += [""]
+    lines += ["## Batch runner (metrics only, 10 s runs at dt = 1 ms)", "",
+              "| controller | back end | runs / s (median) | best | prepare ms / run (serial Python) | load after |",
+              "|---|---|---|---|---|---|"]
+    lines += [f"| {r['controller']} | {r['backend']} | {r['runs_per_s']:.1f} | {r['max_runs_per_s']:.1f} | "
+              f"{r['prepare_ms_per_run']:.2f} | {r['load_avg_1min']} |" for r in doc["batch"]]
+    lines += ["", "## Sweep on Dask distributed (LocalCluster, processes, 1 thread each)", "",
+              f"{doc['sweep'][0]['samples']} samples of {doc['sweep'][0]['run_seconds']:g} s (half FTSMC, half "
+              "FXTNTSMC, chunks of 10), including per-sample scenario validation and preparation and the "
+              "Parquet writes; cluster start-up and warm-up excluded.", "",
+              "| workers | samples / s (median) | best | parallel efficiency (median of paired runs) | load after |",
+              "|---|---|---|---|---|"]
+    lines += [f"| {r['workers']} | {r['samples_per_s']:.1f} | {r['max_samples_per_s']:.1f} | "
+              f"{r['parallel_efficiency']:.2f} | {r['load_avg_1min']} |" for r in doc["sweep"]]
+    lines += ["", "`load after` is the 1-minute load average right after the row was measured; it includes this "
+              "benchmark's own busy cores (up to 2 for the parallel rows), so values well above that mean other "
+              "processes were competing for the 2 cores and the row understates the throughput."]
+    (out / "results.md").write_text("\n".join(lines) + "\n")
