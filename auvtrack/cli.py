@@ -1,4 +1,4 @@
-"""Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce | study``.
+"""Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce | study | sweep``.
 
 Bad input (a scenario error, a missing file, an invalid gain) prints ONE line to stderr and
 exits with status 2, never a traceback.  A simulation that fails (divergence, pitch limit,

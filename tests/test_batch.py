@@ -122,7 +122,7 @@ def test_stage_reuse_of_reference_and_disturbance_is_exact(preps):
     def call(X, fresh, refm, omega):
         dX, tau, aux, work = np.zeros(nx), np.zeros(3), np.zeros(3), np.zeros(WORK_SIZE)
         st = engine.closed_loop_rhs(code, t, X, 0, nx, p.cp, p.vp_nom, p.vp_true, p.ref_p, p.d_rows, p.d_cur,
-                                    np.zeros(3), dX, tau, aux, refm, omega, work, attitude(X[3], X[4]), fresh)
+                                    np.zeros(3), dX, tau, aux, refm, omega, work, attitude(X[3], X[4]), fresh, p.sf)
         assert st == 0
         return dX, tau
 

@@ -92,3 +92,11 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
     assert len(m["verdicts"]) == 3 and "faster convergence" in summary
     for kind in ("fxtntsmc", "ftsmc"):
         assert (tmp_path / kind / "trajectory.csv").exists() and (tmp_path / kind / "run.json").exists()
+    # the fair-tuning comparison really runs the tuned gains (a preset next to written-out gains would not)
+    assert len(m["tuned"]["verdicts"]) == 3 and "under fair tuning" in summary
+    from auvtrack.control.params import get_gain_preset
+
+    for kind in ("fxtntsmc", "ftsmc"):
+        ctrl = json.loads((tmp_path / "tuned" / kind / "run.json").read_text())["scenario"]["controller"]
+        for k, v in get_gain_preset(f"{kind}_tuned").gains.items():
+            assert ctrl[k] == v, (kind, k)

@@ -17,7 +17,7 @@ limit = st.one_of(st.floats(1e-3, 1e4), st.just(math.inf))
 @given(st.tuples(finite, finite, finite), st.tuples(limit, limit, limit))
 def test_saturation_is_the_projection_on_the_box(tau, lim):
     act = pack_actuator(lim, (math.inf,) * 3)
-    out = saturate(tau, act)
+    out = saturate(tau, act, 0)
     for x, y, m in zip(tau, out, lim):
         assert abs(y) <= m
         assert y == (x if abs(x) <= m else math.copysign(m, x))
@@ -27,7 +27,7 @@ def test_saturation_is_the_projection_on_the_box(tau, lim):
        st.floats(1e-3, 0.1))
 def test_rate_limit_moves_at_most_rate_times_h_and_exactly_when_it_can(cmd, prev, rate, h):
     act = pack_actuator((math.inf,) * 3, rate)
-    out = rate_limit(cmd, prev, act, h)
+    out = rate_limit(cmd, prev, act, 0, h)
     for c, p, y, r in zip(cmd, prev, out, rate):
         ulp = 4 * np.finfo(float).eps * max(abs(p), abs(c))  # p +- r h is rounded once
         assert abs(y - p) <= r * h * (1 + 1e-12) + ulp
@@ -65,3 +65,70 @@ def test_measure_adds_row_k_and_nothing_without_noise():
     np.testing.assert_array_equal(np.array(eta + nu), X[:10] + noise[2])
     eta, nu = measure(X, np.zeros((0, 10)), 2)
     np.testing.assert_array_equal(np.array(eta + nu), X[:10])
+
+
+# --- in the closed loop ---------------------------------------------------------------------------
+
+import auvtrack  # noqa: E402
+
+SHORT = ["sim.duration=3", "sim.log_dt=0.001"]
+
+
+def test_saturation_bounds_the_applied_input_in_both_modes():
+    free = auvtrack.simulate({}, SHORT, warn=False)
+    assert max(abs(free["tau_u"])) > 300  # the Section 4 start asks for large inputs
+    for mode in ([], ["sim.control_rate=100"]):
+        res = auvtrack.simulate({}, SHORT + mode + ["actuator.tau_max=[300, 40, 40]"], warn=False)
+        for ch, m in zip(("tau_u", "tau_q", "tau_r"), (300, 40, 40)):
+            assert np.max(np.abs(res[ch])) <= m
+        assert np.max(np.abs(res["tau_u"])) == 300  # the limit is reached, not just respected
+
+
+def test_rate_limit_holds_between_samples_and_starts_from_rest():
+    h, rate = 0.01, 500.0
+    res = auvtrack.simulate({}, SHORT + ["sim.control_rate=100", f"actuator.rate_max=[{rate}, {rate}, {rate}]"],
+                            warn=False)
+    tau = res.to_pandas()[["tau_u", "tau_q", "tau_r"]].to_numpy()
+    samples = tau[::10]  # log every 1 ms, control every 10 ms: the held value of each sample
+    steps = np.abs(np.diff(np.vstack([np.zeros(3), samples]), axis=0))
+    assert steps.max() <= rate * h * (1 + 1e-12)
+    assert steps[:, 0].max() == pytest.approx(rate * h)  # it binds
+    assert np.all(tau[:10] == samples[0])  # zero-order hold inside a sample
+
+
+def test_sensor_noise_is_seeded_and_only_the_controller_sees_it():
+    base = SHORT + ["sim.control_rate=100", "controller.kind=ftsmc"]
+    clean = auvtrack.simulate({}, base, warn=False)
+    noisy = base + ["sensor.sigma_eta=[0.001, 0.001, 0.001, 0.0, 0.0]"]
+    a, b = auvtrack.simulate({}, noisy, warn=False), auvtrack.simulate({}, noisy, warn=False)
+    c = auvtrack.simulate({}, noisy + ["seed=1"], warn=False)
+    np.testing.assert_array_equal(a["tau_u"], b["tau_u"])
+    assert not np.array_equal(a["tau_u"], clean["tau_u"]) and not np.array_equal(a["tau_u"], c["tau_u"])
+    assert np.array_equal(a["t"], clean["t"]) and np.all(np.isfinite(a["x"]))
+    # the logged state is the true one: its virtual-point error is consistent with the log
+    np.testing.assert_allclose(a["xd"], clean["xd"], rtol=0, atol=0)
+
+
+def test_ideal_actuator_and_sensor_change_nothing():
+    """The defaults (inf limits, zero noise) reproduce the run without the sections bit for bit."""
+    a = auvtrack.simulate({}, ["sim.duration=2", "sim.control_rate=100"], warn=False)
+    b = auvtrack.simulate({}, ["sim.duration=2", "sim.control_rate=100", "actuator.tau_max=[inf, inf, inf]",
+                               "actuator.rate_max=[inf, inf, inf]", "sensor.sigma_nu=[0, 0, 0, 0, 0]"], warn=False)
+    for ch in ("x", "tau_u", "tau_q", "ez"):
+        np.testing.assert_array_equal(a[ch], b[ch])
+
+
+def test_realism_study_quick(tmp_path):
+    from auvtrack.studies.realism import FACTORS, run
+
+    report = run(tmp_path, quick=True)
+    doc = json.loads((tmp_path / "results.json").read_text())
+    rows = doc["rows"]
+    assert len(rows) == 2 * (1 + 2 * len(FACTORS))
+    assert {r["factor"] for r in rows} == {"ideal", *(f.name for f in FACTORS)}
+    for r in rows:
+        assert r["status"] in ("ok", "failed") and (r["status"] == "ok") == (r["cause"] is None)
+    ideal = [r for r in rows if r["factor"] == "ideal"]
+    assert all(r["status"] == "ok" and r["rmse"] < 0.05 for r in ideal)
+    text = report.read_text()
+    assert "Failures by cause" in text and (tmp_path / "figures" / "degradation.png").exists()

@@ -8,7 +8,8 @@ disables one.  Two operations, applied in this order to the controller's command
   A rate limit needs a sampling period, so it acts in sampled-data mode
   (``sim.control_rate > 0``) only; the scenario loader refuses it otherwise.
 
-The packed limits ``act_p`` = [tau_max (3), rate_max (3)] (N, N m; N/s, N m/s).
+The packed limits are six numbers [tau_max (3), rate_max (3)] (N, N m; N/s, N m/s) stored in a
+float64 array ``p`` from index ``off`` on (the engine keeps them in its settings vector ``sf``).
 
 References
 ----------
@@ -31,19 +32,18 @@ def _clip(x, lo, hi):
 
 
 @njit
-def saturate(tau3, act_p):
-    """Clip each input to ``[-tau_max_j, tau_max_j]``; returns a 3-tuple (N, N m)."""
-    return (_clip(tau3[0], -act_p[0], act_p[0]),
-            _clip(tau3[1], -act_p[1], act_p[1]),
-            _clip(tau3[2], -act_p[2], act_p[2]))
+def saturate(tau3, p, off):
+    """Clip each input to ``[-tau_max_j, tau_max_j]`` (limits at ``p[off:off+3]``); a 3-tuple."""
+    m0, m1, m2 = p[off + ACT_TAU_MAX], p[off + ACT_TAU_MAX + 1], p[off + ACT_TAU_MAX + 2]
+    return _clip(tau3[0], -m0, m0), _clip(tau3[1], -m1, m1), _clip(tau3[2], -m2, m2)
 
 
 @njit
-def rate_limit(tau3, prev3, act_p, h):
+def rate_limit(tau3, prev3, p, off, h):
     """Move from ``prev3`` towards ``tau3`` by at most ``rate_max_j * h`` per input (3-tuple)."""
-    d0 = act_p[ACT_RATE_MAX] * h
-    d1 = act_p[ACT_RATE_MAX + 1] * h
-    d2 = act_p[ACT_RATE_MAX + 2] * h
+    d0 = p[off + ACT_RATE_MAX] * h
+    d1 = p[off + ACT_RATE_MAX + 1] * h
+    d2 = p[off + ACT_RATE_MAX + 2] * h
     return (_clip(tau3[0], prev3[0] - d0, prev3[0] + d0),
             _clip(tau3[1], prev3[1] - d1, prev3[1] + d1),
             _clip(tau3[2], prev3[2] - d2, prev3[2] + d2))

@@ -23,7 +23,7 @@ from .errors import format_value
 __all__ = [
     "CONTROLLER_MODELS", "ControllerParams", "Scenario", "SimSection", "VehicleSection",
     "UncertaintySection", "InitialSection", "EnvelopeSection", "EstimatorSection",
-    "MetricsSection", "OutputSection",
+    "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection",
 ]
 
 # --- strict scalar types ------------------------------------------------------------------------
@@ -195,6 +195,37 @@ class InitialSection(_Section):
         if not abs(eta[3]) < math.pi / 2:
             raise ValueError(f"3: pitch theta must satisfy |theta| < pi/2 rad (90 deg) (got {eta[3]:g})")
         return eta
+
+
+def _inf_words(value: Any) -> Any:
+    """Accept ``"inf"`` (as written by :meth:`Scenario.to_dict`) for an unlimited actuator."""
+    if isinstance(value, (list, tuple)):
+        return [math.inf if isinstance(x, str) and x.strip().lower() in ("inf", "+inf") else x for x in value]
+    return value
+
+
+PosOrInf = Annotated[float, Strict(), Field(gt=0)]  # +inf allowed (no limit); NaN refused by gt
+PosOrInf3 = tuple[PosOrInf, PosOrInf, PosOrInf]
+
+
+class ActuatorSection(_Section):
+    """``[actuator]``: input limits; ``inf`` = ideal actuator (the paper's assumption)."""
+
+    tau_max: PosOrInf3 = Field((math.inf, math.inf, math.inf), description="|tau_u| (N), |tau_q|, |tau_r| (N m)")
+    rate_max: PosOrInf3 = Field((math.inf, math.inf, math.inf),
+                                description="slew rate, N/s, N m/s (needs sim.control_rate > 0)")
+
+    @field_validator("tau_max", "rate_max", mode="before")
+    @classmethod
+    def _words(cls, v: Any) -> Any:
+        return _inf_words(_broadcast3(v))
+
+
+class SensorSection(_Section):
+    """``[sensor]``: white measurement noise seen by the controller (needs sim.control_rate > 0)."""
+
+    sigma_eta: NonNeg5 = Field((0.0,) * 5, description="std of x, y, z (m), theta, psi (rad)")
+    sigma_nu: NonNeg5 = Field((0.0,) * 5, description="std of u, v, w (m/s), q, r (rad/s)")
 
 
 class EnvelopeSection(_Section):
@@ -376,6 +407,8 @@ class Scenario(BaseModel):
                                               validate_default=True)
     metrics: MetricsSection = Field(default_factory=MetricsSection)
     output: OutputSection = Field(default_factory=OutputSection)
+    actuator: ActuatorSection = Field(default_factory=ActuatorSection)
+    sensor: SensorSection = Field(default_factory=SensorSection)
 
     @field_validator("name")
     @classmethod
@@ -406,6 +439,19 @@ class Scenario(BaseModel):
             if model is not None:
                 _check_numbers(model, v)
         return v
+
+    @model_validator(mode="after")
+    def _sampled_only(self) -> "Scenario":
+        """Rate limits and sensor noise act between control samples: they need a control rate."""
+        if self.sim.control_rate == 0:
+            if any(math.isfinite(r) for r in self.actuator.rate_max):
+                raise ValueError("actuator.rate_max: a finite rate limit needs sim.control_rate > 0 (it acts "
+                                 f"between control samples) (got {format_value(self.actuator.rate_max)})")
+            if any(s > 0 for s in (*self.sensor.sigma_eta, *self.sensor.sigma_nu)):
+                raise ValueError("sensor: noise needs sim.control_rate > 0 (one draw per control sample) "
+                                 f"(got sigma_eta {format_value(self.sensor.sigma_eta)}, "
+                                 f"sigma_nu {format_value(self.sensor.sigma_nu)})")
+        return self
 
     def to_dict(self) -> dict[str, Any]:
         """Fully resolved, JSON-serialisable scenario.

@@ -13,6 +13,8 @@ from .. import __version__
 from ..control import get as get_controller
 from ..control.dispatch import CONTROLLER_STATUS
 from ..environment import build_disturbance, pack_disturbances
+from ..environment.sensors import noise_table
+from ..plant.actuators import pack_actuator
 from ..plant.kinematics import attitude, virtual_point
 from ..plant.presets import get_preset, pack_vehicle
 from ..reference import build_reference
@@ -63,6 +65,7 @@ class Prepared:
     ref_p: np.ndarray
     d_rows: np.ndarray
     d_cur: np.ndarray
+    noise: np.ndarray
     n_rows: int
     channels: tuple[str, ...]
     notes: tuple[str, ...]
@@ -132,11 +135,16 @@ def prepare(scenario: Scenario) -> Prepared:
     naux = len(cc.aux_names)
     si = np.array([n_steps, log_every, ctrl_every, cc.code, naux, cc.xc0.size], dtype=np.int64)
     t0, t1 = sc.metrics.window
-    sf = np.array([dt, math.radians(sc.sim.theta_limit), sc.sim.state_limit, t0,
-                   t1 if math.isfinite(t1) else 1e300])
+    sf = np.concatenate([[dt, math.radians(sc.sim.theta_limit), sc.sim.state_limit, t0,
+                          t1 if math.isfinite(t1) else 1e300],
+                         pack_actuator(sc.actuator.tau_max, sc.actuator.rate_max)])
+    n_samples = n_steps // ctrl_every + 1 if ctrl_every > 0 else 0
+    noise = noise_table(sc.seed, max(n_samples, 1), (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu))
+    if ctrl_every == 0 and noise.shape[0]:  # the schema refuses this; never integrate noise silently
+        raise ValueError("sensor: noise needs sim.control_rate > 0")
     X0 = np.concatenate([eta0, nu0, cc.xc0]).astype(np.float64)
     return Prepared(sc, X0, si, sf, np.ascontiguousarray(cc.cp, dtype=np.float64), vp_nom, vp_true,
-                    ref_p, tables.rows, tables.current, n_steps // log_every + 1,
+                    ref_p, tables.rows, tables.current, noise, n_steps // log_every + 1,
                     BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS, tuple(cc.notes),
                     {"vehicle": vehicle_record, "controller": cc.resolved})
 
@@ -160,7 +168,7 @@ def run_prepared(prep: Prepared) -> Result:
     fail_state = np.zeros(prep.X0.size)
     wall = time.perf_counter()
     cause, rows, t_stop = engine.run_kernel(int(prep.si[engine.SI_CODE]), prep.X0, prep.si, prep.sf, prep.cp, prep.vp_nom, prep.vp_true,
-                                            prep.ref_p, prep.d_rows, prep.d_cur, log, acc, fail_state)
+                                            prep.ref_p, prep.d_rows, prep.d_cur, prep.noise, log, acc, fail_state)
     wall = time.perf_counter() - wall
     failure = None if cause == engine.CAUSE_NONE else _failure(cause, t_stop, fail_state, prep)
     sc = prep.scenario

@@ -105,14 +105,14 @@ def run_metrics(prep: Prepared) -> RunSummary:
     metrics_init(acc)
     fail_state = np.zeros(prep.X0.size)
     cause, _, t_stop = engine.run_kernel(int(prep.si[engine.SI_CODE]), prep.X0, prep.si, prep.sf, prep.cp,
-                                         prep.vp_nom, prep.vp_true, prep.ref_p, prep.d_rows, prep.d_cur, log,
-                                         acc, fail_state)
+                                         prep.vp_nom, prep.vp_true, prep.ref_p, prep.d_rows, prep.d_cur,
+                                         prep.noise, log, acc, fail_state)
     return _summary(prep, cause, t_stop, acc, fail_state)
 
 
 @njit(nogil=True, parallel=True)
-def batch_kernel(codes, X0s, sis, sfs, cps, vp_noms, vp_trues, ref_ps, d_rows, d_curs, ncols, accs, fail_states,
-                 causes, t_stops):
+def batch_kernel(codes, X0s, sis, sfs, cps, vp_noms, vp_trues, ref_ps, d_rows, d_curs, noises, ncols, accs,
+                 fail_states, causes, t_stops):
     """Run ``len(codes)`` closed loops of identical array shapes in a ``prange`` loop, metrics only.
 
     Row ``i`` of every stacked argument is run ``i``'s array for
@@ -124,13 +124,13 @@ def batch_kernel(codes, X0s, sis, sfs, cps, vp_noms, vp_trues, ref_ps, d_rows, d
     for i in numba.prange(n):
         log = np.empty((0, ncols))
         cause, _, t_stop = engine.run_kernel(codes[i], X0s[i], sis[i], sfs[i], cps[i], vp_noms[i], vp_trues[i],
-                                             ref_ps[i], d_rows[i], d_curs[i], log, accs[i], fail_states[i])
+                                             ref_ps[i], d_rows[i], d_curs[i], noises[i], log, accs[i], fail_states[i])
         causes[i] = cause
         t_stops[i] = t_stop
 
 
 def _shape_key(p: Prepared) -> tuple:
-    return (p.X0.shape, p.cp.shape, p.ref_p.shape, p.d_rows.shape, p.d_cur.shape, len(p.channels))
+    return (p.X0.shape, p.cp.shape, p.ref_p.shape, p.d_rows.shape, p.d_cur.shape, p.noise.shape, len(p.channels))
 
 
 def _run_prange(preps: Sequence[Prepared]) -> list[RunSummary]:
@@ -150,8 +150,8 @@ def _run_prange(preps: Sequence[Prepared]) -> list[RunSummary]:
         t_stops = np.zeros(n)
         codes = np.array([int(p.si[engine.SI_CODE]) for p in ps], dtype=np.int64)
         batch_kernel(codes, stack("X0"), stack("si"), stack("sf"), stack("cp"), stack("vp_nom"), stack("vp_true"),
-                     stack("ref_p"), stack("d_rows"), stack("d_cur"), len(ps[0].channels), accs, fails, causes,
-                     t_stops)
+                     stack("ref_p"), stack("d_rows"), stack("d_cur"), stack("noise"), len(ps[0].channels), accs,
+                     fails, causes, t_stops)
         for k, i in enumerate(idx):
             out[i] = _summary(preps[i], causes[k], t_stops[k], accs[k], fails[k])
     return out  # type: ignore[return-value]

@@ -7,6 +7,12 @@ weights, envelope filters) are integrated together.  Two modes:
 * sampled-data (``ctrl_every = k``): the controller runs every k steps on the measured state and
   its input tau and internal-state derivative are held (zero-order hold) until the next sample.
 
+Actuators and sensors (:mod:`auvtrack.plant.actuators`, :mod:`auvtrack.environment.sensors`):
+the applied input is the command saturated to ``|tau_j| <= tau_max_j`` (both modes); in
+sampled-data mode it is also rate limited between samples (from tau = 0 at t = 0), and the
+controller sees the state plus row k of the seeded noise table ``noise`` at sample k.  Logs and
+metrics always use the true state and the applied input.
+
 One row is logged every ``log_every`` steps into a preallocated array (O(N) in total).  After
 every step the state is checked; a failure stops the run at once and keeps what was logged.
 Integer settings ``si`` and float settings ``sf`` use the index constants below.
@@ -27,6 +33,8 @@ from ..control.dispatch import NX_PLANT, WORK_SIZE, control
 from ..control.tracking import lumped_disturbance
 from ..environment import eval_disturbance
 from ..environment.layout import KIND_PAPER, KIND_PULSE
+from ..environment.sensors import measure
+from ..plant.actuators import ACT_SIZE, rate_limit, saturate
 from ..plant.dynamics import nu_dot
 from ..plant.kinematics import attitude, eta_dot, virtual_point
 from ..plant.params import ELL
@@ -35,8 +43,8 @@ from .metrics import metrics_update
 
 SI_NSTEPS, SI_LOG_EVERY, SI_CTRL_EVERY, SI_CODE, SI_NAUX, SI_NC = range(6)
 SI_SIZE = 6
-SF_DT, SF_THETA_LIM, SF_STATE_LIM, SF_WIN_T0, SF_WIN_T1 = range(5)
-SF_SIZE = 5
+SF_DT, SF_THETA_LIM, SF_STATE_LIM, SF_WIN_T0, SF_WIN_T1, SF_ACT = range(6)
+SF_SIZE = SF_ACT + ACT_SIZE  # sf[SF_ACT:] = actuator limits [tau_max (3), rate_max (3)]
 
 # logged row: t, eta(5), nu(5), tau(3), eta_d(3), e(3), aux(naux), chi(3)
 N_BASE_COLS = 20
@@ -60,7 +68,7 @@ def plant_state(X):
 
 @njit
 def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, dX, tau, aux,
-                    refm, omega, work, att, fresh):
+                    refm, omega, work, att, fresh, sf):
     """Write dX/dt; return 0 or a controller status.  ``hold`` = [tau (3), dxc] in sampled mode.
 
     ``att`` is :func:`attitude` of X (the caller computes it once per stage).  With ``fresh``
@@ -76,6 +84,7 @@ def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_ro
         status = control(code, t, eta, nu, X, refm, vp_nom, cp, tau, dX, aux, work)
         if status != 0:
             return status
+        tau[0], tau[1], tau[2] = saturate((tau[0], tau[1], tau[2]), sf, SF_ACT)
     else:
         tau[0], tau[1], tau[2] = hold[0], hold[1], hold[2]
         for i in range(NX_PLANT, nx):
@@ -148,7 +157,7 @@ def _fail(status, X, fail_state):
 
 
 @njit(nogil=True)
-def run_kernel(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state):
+def run_kernel(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state):
     """Integrate the closed loop of controller ``code``; return (cause, rows_logged, t_stop).
 
     The one run-time switch on ``code``: each branch calls :func:`integrate` with a constant,
@@ -158,16 +167,16 @@ def run_kernel(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log,
     state at the stop is copied into ``fail_state``.
     """
     if code == 1:  # ftsmc.CODE (a literal: numba needs it in the source)
-        return integrate(1, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state)
+        return integrate(1, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state)
     if code == 2:  # fxtntsmc.CODE (a literal: numba needs it in the source)
-        return integrate(2, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state)
+        return integrate(2, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state)
     if code == 3:  # open_loop.CODE (a literal: numba needs it in the source)
-        return integrate(3, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state)
+        return integrate(3, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state)
     return CAUSE_CONTROLLER + 99, 0, 0.0
 
 
 @njit(nogil=True)
-def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, acc, fail_state):
+def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state):
     """The RK4 loop of :func:`run_kernel` for one controller; ``code`` is a compile-time literal.
 
     ``numba.literally`` makes the controller dispatch fold away (a run-time switch per stage
@@ -194,19 +203,20 @@ def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, 
         t = k * dt
         if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, hold
             eval_reference(ref_p, t, refm)
-            eta, nu = plant_state(X)
+            eta, nu = measure(X, noise, k // ctrl_every)
             status = control(code, t, eta, nu, X, refm, vp_nom, cp, tau1, k1, aux1, work)
             if status == 0 and not _finite3(tau1):
                 status = STATUS_NONFINITE_INPUT
             if status != 0:
                 return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
-            hold[0], hold[1], hold[2] = tau1[0], tau1[1], tau1[2]
+            cmd = saturate((tau1[0], tau1[1], tau1[2]), sf, SF_ACT)
+            hold[0], hold[1], hold[2] = rate_limit(cmd, (hold[0], hold[1], hold[2]), sf, SF_ACT, ctrl_every * dt)
             for i in range(NX_PLANT, nx):
                 hold[3 + i - NX_PLANT] = k1[i]
         # stage 1 at (t, X): also the values that are logged and enter the metrics
         att = attitude(X[3], X[4])
         status = closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold,
-                                 k1, tau1, aux1, refm, omega, work, att, True)
+                                 k1, tau1, aux1, refm, omega, work, att, True, sf)
         if status == 0 and not _finite3(tau1):
             status = STATUS_NONFINITE_INPUT
         if status != 0:
@@ -223,17 +233,17 @@ def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, log, 
         for i in range(nx):
             Xs[i] = X[i] + 0.5 * dt * k1[i]
         status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
-                                 hold, k2, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True)
+                                 hold, k2, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True, sf)
         if status == 0:
             for i in range(nx):
                 Xs[i] = X[i] + 0.5 * dt * k2[i]
             status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows,
-                                     d_cur, hold, k3, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), not reuse)
+                                     d_cur, hold, k3, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), not reuse, sf)
         if status == 0:
             for i in range(nx):
                 Xs[i] = X[i] + dt * k3[i]
             status = closed_loop_rhs(code, t + dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
-                                     hold, k4, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True)
+                                     hold, k4, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True, sf)
         if status != 0:
             return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
         for i in range(nx):
