@@ -111,3 +111,82 @@ def test_second_loop_rho_ddot_matches_finite_differences(kind):
 def test_outside_envelope_is_reported():
     assert E.axis_transform(E.RIGID, 0.0, 5.0, 0.0, 0.0, EP, 0, 0)[0] == 1
     assert E.axis_transform(E.RIGID, 0.0, 4.99, 0.0, 0.0, EP, 0, 0)[0] == 0
+
+
+def _baseline_eq24(t, rho0, rinf, T):
+    if t >= T:
+        return rinf, 0.0, 0.0
+    s = T - t
+    a = (rho0 - rinf) * math.exp(-t / s)
+    return a + rinf, -a * T / s**2, a * (T**2 / s**4 - 2 * T / s**3)
+
+
+def test_shared_baseline_factor_matches_eq24_per_axis():
+    """The law evaluates exp(-t/(T-t)) once for three axes; each axis equals eq. (24)."""
+    for t in (0.0, 0.3, 7.5, 14.9, 14.999, 15.0, 20.0):
+        shape = E.baseline_shape(t, 15.0)
+        for rho0, rinf in ((0.5, 0.005), (5.0, 0.01), (0.2, 0.2)):
+            got = E.baseline_from_shape(shape, rho0, rinf, False)
+            assert got == E.baseline(t, rho0, rinf, 15.0, False)
+            np.testing.assert_allclose(got, _baseline_eq24(t, rho0, rinf, 15.0), rtol=1e-12, atol=1e-300)
+
+
+def _axis_transform_divisions(kind, t, e, ed, rb, ep, i):
+    """Eq. (17-25) written with plain divisions (reference for the reciprocal form)."""
+    T, delta, eps, lam1, lam2, lam3, thr = ep[:7]
+    rho1, rho1d, rho1dd = E.baseline(t, ep[8 + i], ep[11 + i], T, ep[7] != 0.0)
+    rho = rho1 + rb
+    xi = e / rho
+    axi = abs(xi)
+    th = math.tanh(axi / lam3)
+    dth = (1.0 - th * th) / lam3
+    base = rho1d - lam1 * rb
+    g, gd_h, gd_a, q = 0.0, 0.0, 0.0, 0.0
+    if kind == E.PROACTIVE:
+        h0 = -2.0 * xi * ed / rho + delta * (1.0 - xi * xi) + 2.0 * xi * xi / rho * base
+        k = 2.0 * xi * xi / rho * lam2 * th
+        g = E.solve_risk_loop(h0, k, eps)
+        gd_h = E.risk_indicator(h0 + k * g, eps)[1]
+    elif kind == E.REACTIVE:
+        g, gd_a = E.reactive_trigger(axi, thr)
+    rbd = -lam1 * rb + lam2 * g * th
+    rhod = rho1d + rbd
+    xid = ed / rho - e * rhod / (rho * rho)
+    rbdd_0 = -lam1 * rbd + lam2 * (g * dth + gd_a * th) * np.sign(xi) * xid
+    p = rho1dd + rbdd_0
+    if kind == E.PROACTIVE:
+        c_h = lam2 * th * gd_h
+        X0 = -2.0 * ed * rhod / (rho * rho) + 2.0 * e * rhod * rhod / (rho * rho * rho)
+        K0 = p + c_h * (-2.0 * xid * xid - 2.0 * delta * xi * xid)
+        den = 1.0 - 2.0 * c_h * xi * e / (rho * rho)
+        p, q = (K0 - 2.0 * c_h * xi * X0) / den, -(2.0 * c_h * xi / rho) / den
+    D = rho * rho - e * e
+    Dd = 2.0 * rho * rhod - 2.0 * e * ed
+    Om, U = rho / D, rhod / D
+    z = 0.5 * math.log((1.0 + xi) / (1.0 - xi))
+    return (z, Om * ed - U * e, Om, U, rhod / D - rho * Dd / (D * D),
+            (p / D - rhod * Dd / (D * D)) * e, q / D * e, rho, rbd, rho1, g)
+
+
+@pytest.mark.parametrize("kind", [E.RIGID, E.REACTIVE, E.PROACTIVE])
+def test_reciprocal_form_matches_the_divisions(kind):
+    rng = np.random.default_rng(2)
+    checked = 0
+    for _ in range(3000):
+        t, i = rng.uniform(0, 16), int(rng.integers(3))
+        rb = rng.uniform(0, 0.1)
+        rho = E.baseline(t, EP[8 + i], EP[11 + i], 15.0, False)[0] + rb
+        e = rng.uniform(-1, 1) * rho * rng.choice([1.0, 0.999, 0.9, 0.1, 1e-4])
+        ed = rng.normal(0, 0.3)
+        status, got = E.axis_transform(kind, t, e, ed, rb, EP, 0, i)
+        if status != 0:
+            continue
+        ref = _axis_transform_divisions(kind, t, e, ed, rb, EP, i)
+        got, ref = np.array(got), np.array(ref)
+        # z: the log form of eq. (17) loses relative accuracy near xi = 0 (atanh does not);
+        # both agree to a few ulp of 1 in absolute terms
+        assert abs(got[0] - ref[0]) <= 1e-12 * abs(ref[0]) + 1e-15
+        scale = np.maximum(np.abs(ref[1:]), 1e-3 * np.abs(ref[1:]).max())
+        np.testing.assert_array_less(np.abs(got[1:] - ref[1:]), 1e-12 * scale + 1e-300)
+        checked += 1
+    assert checked > 2500

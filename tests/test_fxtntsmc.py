@@ -167,3 +167,55 @@ def test_run_json_records_the_start_treatment(tmp_path):
     loaded = auvtrack.Result.load(folder)
     assert loaded.scenario["resolved"]["controller"]["rho_bar0"][1] > 0
     assert any("widened" in n for n in loaded.meta["notes"])
+
+
+def _surface_eq28(z, a1, a2, a3, a4, printed, zs, zfloor):
+    """Eq. (28) written with a pow per term (reference for the one-pow compiled form)."""
+    az, s = abs(z), np.sign(z)
+    if not printed and az <= zs:
+        c1, c2 = (2 - a2) * zs ** (a2 - 1), (a2 - 1) * zs ** (a2 - 2)
+        g, dg = c1 * z + c2 * s * z * z, c1 + 2 * c2 * az
+    else:
+        g, dg = s * az**a2, a2 * max(az, zfloor) ** (a2 - 1)
+    return a1 * g + a3 * s * az**a4, a1 * dg + a3 * a4 * az ** (a4 - 1)
+
+
+def _switch_eq27(se, alpha, sigma):
+    a = abs(se)
+    if a > sigma:
+        return np.sign(se) * a**alpha, alpha * a ** (alpha - 1)
+    b1, b2 = (2 - alpha) * sigma ** (alpha - 1), (alpha - 1) * sigma ** (alpha - 2)
+    return b1 * se + b2 * np.sign(se) * se * se, b1 + 2 * b2 * a
+
+
+def test_one_pow_forms_match_eq27_eq28():
+    """surface/switch compute x^p as x x^(p-1) with precomputed coefficients: same to ~1e-12."""
+    rng = np.random.default_rng(1)
+    zs_ = np.concatenate([rng.uniform(-3, 3, 400), rng.uniform(-0.02, 0.02, 400),
+                          [0.0, 1e-7, -1e-7, 0.01, -0.01]])
+    for a2, a4, printed in ((0.8, 2.0, False), (0.6, 1.7, False), (0.8, 2.0, True), (0.55, 3.0, True)):
+        for z in zs_:
+            args = (z, 0.8, a2, 0.7, a4, printed, 0.01, 1e-6)
+            np.testing.assert_allclose(surface(*args), _surface_eq28(*args), rtol=1e-12, atol=1e-300)
+    for alpha in (0.6, 0.9, 1.5):
+        for se in np.concatenate([zs_, rng.uniform(-0.006, 0.006, 200)]):
+            np.testing.assert_allclose(switch(se, alpha, 0.005), _switch_eq27(se, alpha, 0.005),
+                                       rtol=1e-12, atol=1e-300)
+
+
+def test_setup_packs_the_precomputed_coefficients():
+    from auvtrack.control import fxtntsmc as F
+    p = prepare(load_scenario(PAPER, ["sim.duration=0.1", "controller.a2=0.7", "controller.alpha=0.65"]))
+    assert p.cp[F.SC1] == pytest.approx((2 - 0.7) * 0.01 ** (0.7 - 1), rel=1e-15)
+    assert p.cp[F.SC2] == pytest.approx((0.7 - 1) * 0.01 ** (0.7 - 2), rel=1e-15)
+    assert p.cp[F.SB1] == pytest.approx((2 - 0.65) * 0.005 ** (0.65 - 1), rel=1e-15)
+    assert p.cp[F.SB2] == pytest.approx((0.65 - 1) * 0.005 ** (0.65 - 2), rel=1e-15)
+    assert p.cp[F.EST] == 2 and p.cp[F.NEUR] == 7  # Section 4: omega-weighted law, 7 neurons
+
+
+def test_ftsmc_sig_pair_matches_two_sig_calls():
+    from auvtrack.control.tracking import sig, sig_pair
+    for gam in (1.1, 1.5, 1.9):
+        for x in (0.0, 1e-300, -1e-200, 1e-8, -0.3, 2.5, -1e3, 1e150):
+            got, ref = sig_pair(x, gam), (sig(x, gam), sig(x, 2.0 - gam))
+            np.testing.assert_allclose(got, ref, rtol=1e-12, atol=0)

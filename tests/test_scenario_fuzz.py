@@ -187,7 +187,7 @@ OUT_OF_RANGE = _constrained() + CROSS + NON_FINITE
 
 # --- wrong types --------------------------------------------------------------------------------
 
-BROADCAST = {("envelope", "rho0"), ("envelope", "rho_inf")}
+BROADCAST = {("envelope", "rho0"), ("envelope", "rho_inf"), ("actuator", "tau_max"), ("actuator", "rate_max")}
 
 
 def _wrong_type(path):

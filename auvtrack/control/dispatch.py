@@ -39,7 +39,7 @@ CONTROLLER_STATUS = {
 }
 
 
-@njit
+@njit(_nrt=False)  # no reference counting of the 8 array arguments (it allocates nothing): ~0.4 us/step
 def control(code, t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
     """Evaluate controller ``code`` (a compile-time literal); unknown codes return status 99."""
     literally(code)

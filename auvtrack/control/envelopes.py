@@ -38,6 +38,40 @@ ENVELOPES = {"none": NONE, "rigid": RIGID, "reactive": REACTIVE, "proactive": PR
 REACTIVE_BAND = 0.05
 
 
+AFTER_T = (0, 0.0, 0.0, 0.0)  # baseline_shape for t >= T
+
+
+@njit
+def baseline_shape(t, T):
+    """The time factor of eq. (24), shared by every axis: (state, exp(phi), phi_dot, phi_dot^2 + phi_ddot).
+
+    phi = -t / (T - t); state 0: t >= T (rho1 = rho_inf), 1: exp(phi) underflows, 2: t < T.
+    d/dt exp(phi) = exp(phi) phi_dot and d^2/dt^2 exp(phi) = exp(phi) (phi_dot^2 + phi_ddot).
+    """
+    if t >= T:
+        return 0, 0.0, 0.0, 0.0
+    s = T - t
+    phi = -t / s
+    if phi < -700.0:
+        return 1, 0.0, 0.0, 0.0
+    d1 = -T / (s * s)
+    d2 = -2.0 * T / (s * s * s)
+    return 2, math.exp(phi), d1, d1 * d1 + d2
+
+
+@njit
+def baseline_from_shape(shape, rho0, rho_inf, printed):
+    """rho1, rho1_dot, rho1_ddot of eq. (24) for one axis from :func:`baseline_shape`."""
+    state, ex, d1, d11 = shape
+    if state == 0:
+        return rho_inf, 0.0, 0.0
+    if state == 1:
+        return (0.0 if printed else rho_inf), 0.0, 0.0
+    a = (rho0 - rho_inf) * ex
+    r = a if printed else a + rho_inf
+    return r, a * d1, a * d11
+
+
 @njit
 def baseline(t, rho0, rho_inf, T, printed):
     """Baseline envelope rho1 of eq. (24) and its first two derivatives (m, m/s, m/s^2).
@@ -46,17 +80,7 @@ def baseline(t, rho0, rho_inf, T, printed):
     rho_inf afterwards; C-infinity at T.  ``printed``: the form as printed, without
     + rho_inf for t < T (decays to 0 at T, then jumps to rho_inf).
     """
-    if t >= T:
-        return rho_inf, 0.0, 0.0
-    s = T - t
-    phi = -t / s
-    if phi < -700.0:
-        return (0.0 if printed else rho_inf), 0.0, 0.0
-    a = (rho0 - rho_inf) * math.exp(phi)
-    d1 = -T / (s * s)
-    d2 = -2.0 * T / (s * s * s)
-    r = a if printed else a + rho_inf
-    return r, a * d1, a * (d1 * d1 + d2)
+    return baseline_from_shape(baseline_shape(t, T), rho0, rho_inf, printed)
 
 
 @njit
@@ -115,53 +139,90 @@ def axis_transform(kind, t, e, ed, rb, ep, off, i):
     where U_dot e = c0 + c1 e_ddot collects every U_dot term (loop 2 of ERRATA 10), so that
     z_ddot = Omega_dot e_dot + Omega e_ddot - (c0 + c1 e_ddot) - U e_dot.
     """
+    prm = params(ep, off)
+    if kind == NONE:
+        return axis_transform_given(kind, e, ed, rb, prm, (math.nan, 0.0, 0.0))
+    r1 = baseline(t, ep[off + 8 + i], ep[off + 11 + i], ep[off], ep[off + 7] != 0.0)
+    return axis_transform_given(kind, e, ed, rb, prm, r1)
+
+
+@njit
+def _tanh_and_slope(a, lam3):
+    """tanh(a / lambda3) of eq. (25) and its derivative in a."""
+    il3 = 1.0 / lam3
+    th = math.tanh(a * il3)
+    return th, (1.0 - th * th) * il3
+
+
+@njit
+def params(ep, off):
+    """(delta, eps, lambda1, lambda2, lambda3, thr) from ``ep[off : off + 14]`` as a tuple."""
+    return ep[off + 1], ep[off + 2], ep[off + 3], ep[off + 4], ep[off + 5], ep[off + 6]
+
+
+@njit
+def axis_transform_given(kind, e, ed, rb, prm, r1):
+    """:func:`axis_transform` with prm = :func:`params` and r1 = (rho1, rho1_dot, rho1_ddot) given.
+
+    The compiled law evaluates exp(-t / (T - t)) once for the three axes
+    (:func:`baseline_shape`) and passes each axis' :func:`baseline_from_shape`.  Scalars and
+    tuples only (no arrays: an array argument costs two atomic reference-count updates per call).
+    Divisions by rho, D = rho^2 - e^2, lambda3 and den are multiplications by their reciprocals.
+    """
     if kind == NONE:
         return 0, (e, ed, 1.0, 0.0, 0.0, 0.0, 0.0, math.nan, 0.0, math.nan, 0.0)
-    T, delta, eps = ep[off], ep[off + 1], ep[off + 2]
-    lam1, lam2, lam3 = ep[off + 3], ep[off + 4], ep[off + 5]
-    rho1, rho1d, rho1dd = baseline(t, ep[off + 8 + i], ep[off + 11 + i], T, ep[off + 7] != 0.0)
+    delta, eps, lam1, lam2, lam3, thr = prm
+    rho1, rho1d, rho1dd = r1
     rho = rho1 + rb
-    xi = e / rho
+    ir = 1.0 / rho
+    xi = e * ir
     if not abs(xi) < 1.0:
         return 1, OUTSIDE
     axi = abs(xi)
-    th = math.tanh(axi / lam3)
-    dth = (1.0 - th * th) / lam3
     sgn = 1.0 if xi > 0.0 else (-1.0 if xi < 0.0 else 0.0)
     base = rho1d - lam1 * rb
     g, gd_h, gd_a, c_h = 0.0, 0.0, 0.0, 0.0
+    # tanh(|xi| / lambda3) of eq. (25) and its derivative only ever multiply g, g' or gamma';
+    # they are evaluated where one of these can be non-zero (all are exactly 0 elsewhere)
+    th, dth = 0.0, 0.0
     if kind == PROACTIVE:
         # hbar = -2 xi xi_dot + delta (1 - xi^2), xi_dot = e_dot/rho - e rho_dot/rho^2 (eq. 20-21)
-        h0 = -2.0 * xi * ed / rho + delta * (1.0 - xi * xi) + 2.0 * xi * xi / rho * base
-        k = 2.0 * xi * xi / rho * lam2 * th
-        g = solve_risk_loop(h0, k, eps)
-        _, gd_h = risk_indicator(h0 + k * g, eps)
+        h0 = -2.0 * xi * ed * ir + delta * (1.0 - xi * xi) + 2.0 * xi * xi * ir * base
+        if not h0 >= 2.0 * eps:  # else g = gamma(h0 + k g) = 0 exactly, for every k >= 0
+            th, dth = _tanh_and_slope(axi, lam3)
+            k = 2.0 * xi * xi * ir * lam2 * th
+            g = solve_risk_loop(h0, k, eps)
+            _, gd_h = risk_indicator(h0 + k * g, eps)
     elif kind == REACTIVE:
-        g, gd_a = reactive_trigger(axi, ep[off + 6])
+        g, gd_a = reactive_trigger(axi, thr)
+        if g != 0.0 or gd_a != 0.0:
+            th, dth = _tanh_and_slope(axi, lam3)
     rbd = -lam1 * rb + lam2 * g * th
     rhod = rho1d + rbd
-    xid = ed / rho - e * rhod / (rho * rho)
+    xid = (ed - e * rhod * ir) * ir  # e_dot/rho - e rho_dot/rho^2
     axid = sgn * xid
     # rho_ddot = p + q e_ddot
     rbdd_0 = -lam1 * rbd + lam2 * (g * dth + gd_a * th) * axid
     q = 0.0
-    if kind == PROACTIVE:
+    if gd_h != 0.0:  # proactive, inside the band of gamma (otherwise c_h = 0: p = K0, q = 0)
         c_h = lam2 * th * gd_h  # <= 0
         # hbar_dot = -2 xid^2 - 2 xi xidd - 2 delta xi xid, xidd = edd/rho + X0 - e rhodd/rho^2
-        X0 = -2.0 * ed * rhod / (rho * rho) + 2.0 * e * rhod * rhod / (rho * rho * rho)
+        ir2 = ir * ir
+        X0 = -2.0 * ed * rhod * ir2 + 2.0 * e * rhod * rhod * ir2 * ir
         K0 = rho1dd + rbdd_0 + c_h * (-2.0 * xid * xid - 2.0 * delta * xi * xid)
-        den = 1.0 - 2.0 * c_h * xi * e / (rho * rho)  # >= 1
-        p = (K0 - 2.0 * c_h * xi * X0) / den
-        q = -(2.0 * c_h * xi / rho) / den
+        iden = 1.0 / (1.0 - 2.0 * c_h * xi * e * ir2)  # den >= 1
+        p = (K0 - 2.0 * c_h * xi * X0) * iden
+        q = -(2.0 * c_h * xi * ir) * iden
     else:
         p = rho1dd + rbdd_0
     D = rho * rho - e * e
-    Om = rho / D
-    U = rhod / D
+    iD = 1.0 / D
+    Om = rho * iD
+    U = rhod * iD
     Dd = 2.0 * rho * rhod - 2.0 * e * ed
-    z = 0.5 * math.log((1.0 + xi) / (1.0 - xi))
-    Omd = rhod / D - rho * Dd / (D * D)
+    z = math.atanh(xi)  # = 0.5 ln((1 + xi) / (1 - xi)), eq. (17)
+    Omd = U - Om * Dd * iD  # rho_dot / D - rho Dd / D^2
     # U_dot = rho_ddot / D - rho_dot Dd / D^2, rho_ddot = p + q e_ddot
-    c0 = (p / D - rhod * Dd / (D * D)) * e
-    c1 = q / D * e
+    c0 = (p - U * Dd) * iD * e
+    c1 = q * iD * e
     return 0, (z, Om * ed - U * e, Om, U, Omd, c0, c1, rho, rbd, rho1, g)

@@ -20,7 +20,7 @@ from .._jit import njit
 from ..plant.kinematics import attitude
 from .params import FTSMCParams
 from .registry import CompiledController
-from .tracking import error_state, input_for_accel, sig, sign
+from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
 
 CODE = 1
 AUX_NAMES = ("s_x", "s_y", "s_z")
@@ -29,20 +29,25 @@ AUX_NAMES = ("s_x", "s_y", "s_z")
 @njit
 def reaching(e, ed, beta, gam, k1, k2):
     """Sliding variable s and commanded e_ddot of one axis."""
-    s = e + beta * sig(ed, gam)
-    return s, -sig(ed, 2.0 - gam) / (beta * gam) - k1 * sign(s) - k2 * s
+    sg, s2g = sig_pair(ed, gam)  # sig^gamma(e_dot), sig^(2-gamma)(e_dot)
+    s = e + beta * sg
+    return s, -s2g / (beta * gam) - k1 * sign(s) - k2 * s
 
 
-@njit
+# _nrt=False: compiled without Numba's reference counting. The law only reads and writes the
+# arrays its caller owns and allocates nothing, so the 8 array arguments need no incref/decref;
+# with it, each call paid 16 atomic updates (~0.1 us per call, 0.4 us per RK4 step). An
+# allocation added here fails to compile rather than leak. (_nrt is a private Numba option.)
+@njit(_nrt=False)
 def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FTSMC law; returns status 0 (it has no failure modes of its own)."""
     att = attitude(eta[3], eta[4])
-    e, ed, f = error_state(eta, att, nu, refm, vp)
+    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
     s0, a0 = reaching(e[0], ed[0], cp[0], cp[1], cp[2], cp[3])
     s1, a1 = reaching(e[1], ed[1], cp[0], cp[1], cp[2], cp[3])
     s2, a2 = reaching(e[2], ed[2], cp[0], cp[1], cp[2], cp[3])
     aux[0], aux[1], aux[2] = s0, s1, s2
-    tau[0], tau[1], tau[2] = input_for_accel(att, nu, vp, f, (a0, a1, a2))
+    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, (a0, a1, a2), gf)
     return 0
 
 

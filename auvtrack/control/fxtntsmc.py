@@ -24,7 +24,6 @@ z (transformed error).
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -33,16 +32,22 @@ from . import envelopes, rbf
 from .registry import CompiledController
 from ..plant.kinematics import attitude
 from .dispatch_layout import NX_PLANT, WORK_SIZE
-from .tracking import error_state, input_for_accel, sign
+from .tracking import error_state_forces, input_for_accel_forces, sign
 
 CODE = 2
 AXES = ("x", "y", "z")
 AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "S", "g", "z") for a in AXES)
 
-# packed parameters
+# Packed parameters cp (built by :func:`setup`):
+#   0-11   kappa1, kappa2, kappa3, a1, a2, a3, a4, alpha, sigma, surface code, z_switch, z_floor
+#   12     envelope kind;  13-26  the 14 envelope parameters of envelopes.axis_transform
+#   27-30  constants precomputed once (they only depend on gains): c1, c2 of the nonsingular
+#          quadratic (surface_coeffs) and beta1, beta2 of eq. (27) (switch_coeffs)
+#   31-33  estimator code, neurons m, RBF width;  34-  the 6 m RBF centres
 K1, K2, K3, A1, A2, A3, A4, ALPHA, SIGMA, SURF, ZSW, ZFL = range(12)
 ENV, EP0 = 12, 13  # envelope kind, then the 14 envelope parameters of envelopes.axis_transform
-EST, NEUR, WIDTH, CENT = 27, 28, 29, 30
+SC1, SC2, SB1, SB2 = 27, 28, 29, 30
+EST, NEUR, WIDTH, CENT = 31, 32, 33, 34
 SURFACES = {"nonsingular": 0, "printed": 1}
 XC = NX_PLANT  # internal state [rho_bar (3), W (3 m)] starts here in X
 ACC = WORK_SIZE - 3  # scratch slots of the commanded e_ddot
@@ -54,49 +59,108 @@ class StartOutsideEnvelope(ValueError):
 
 
 @njit
-def surface(z, a1, a2, a3, a4, printed, zs, zfloor):
-    """S_e(z) of eq. (28) and dS_e/dz, singular-free unless ``printed`` (ERRATA 12)."""
-    az = abs(z)
-    s = sign(z)
-    if not printed and az <= zs:
-        c1 = (2.0 - a2) * zs ** (a2 - 1.0)
-        c2 = (a2 - 1.0) * zs ** (a2 - 2.0)
-        g, dg = c1 * z + c2 * s * z * z, c1 + 2.0 * c2 * az
-    else:
-        g, dg = s * az**a2, a2 * max(az, zfloor) ** (a2 - 1.0)
-    return a1 * g + a3 * s * az**a4, a1 * dg + a3 * a4 * az ** (a4 - 1.0)
+def surface_coeffs(a2, zs):
+    """c1, c2 of the C1 quadratic c1 z + c2 sign(z) z^2 that replaces sig^a2(z) for |z| <= zs.
+
+    Matches value and slope of sig^a2 at |z| = zs (ERRATA 12); constant per run, so the
+    compiled law reads them from ``cp`` (packed by :func:`setup`).
+    """
+    return (2.0 - a2) * zs ** (a2 - 1.0), (a2 - 1.0) * zs ** (a2 - 2.0)
 
 
 @njit
-def switch(se, alpha, sigma):
-    """S1(S_e) of eq. (27) and its derivative; C1 at |S_e| = sigma."""
+def switch_coeffs(alpha, sigma):
+    """beta1, beta2 of eq. (27): C1 at |S_e| = sigma; constant per run (packed in ``cp``)."""
+    return (2.0 - alpha) * sigma ** (alpha - 1.0), (alpha - 1.0) * sigma ** (alpha - 2.0)
+
+
+@njit
+def pow_and_power_below(x, p):
+    """(x^p, x^(p-1)) with one pow: x^p = x x^(p-1), and x^(p-1) = x when p = 2.
+
+    x >= 0, and x > 0 when p < 1 (x^(p-1) is infinite at 0; callers stay away from 0 there).
+    """
+    q = x if p == 2.0 else x ** (p - 1.0)
+    return x * q, q
+
+
+@njit
+def surface_c(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2):
+    """:func:`surface` with the quadratic's coefficients (c1, c2) = surface_coeffs(a2, zs) given."""
+    az = abs(z)
+    s = sign(z)
+    if not printed and az <= zs:
+        g, dg = c1 * z + c2 * s * z * z, c1 + 2.0 * c2 * az
+    elif az >= zfloor:
+        pa, qa = pow_and_power_below(az, a2)
+        g, dg = s * pa, a2 * qa
+    else:
+        g, dg = s * az**a2, a2 * zfloor ** (a2 - 1.0)
+    pb, qb = pow_and_power_below(az, a4)
+    return a1 * g + a3 * s * pb, a1 * dg + a3 * a4 * qb
+
+
+@njit
+def surface(z, a1, a2, a3, a4, printed, zs, zfloor):
+    """S_e(z) of eq. (28) and dS_e/dz, singular-free unless ``printed`` (ERRATA 12).
+
+    S_e = a1 sig^a2(z) + a3 sig^a4(z); "nonsingular": sig^a2 -> c1 z + c2 sign(z) z^2 for
+    |z| <= zs; "printed": |z|^(a2-1) -> max(|z|, zfloor)^(a2-1) in the derivative.
+    """
+    c1, c2 = surface_coeffs(a2, zs)
+    return surface_c(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2)
+
+
+@njit
+def switch_c(se, alpha, sigma, b1, b2):
+    """:func:`switch` with (beta1, beta2) = switch_coeffs(alpha, sigma) given."""
     a = abs(se)
     if a > sigma:
-        return sign(se) * a**alpha, alpha * a ** (alpha - 1.0)
-    b1 = (2.0 - alpha) * sigma ** (alpha - 1.0)
-    b2 = (alpha - 1.0) * sigma ** (alpha - 2.0)
+        pa, qa = pow_and_power_below(a, alpha)
+        return sign(se) * pa, alpha * qa
     return b1 * se + b2 * sign(se) * se * se, b1 + 2.0 * b2 * a
 
 
 @njit
+def switch(se, alpha, sigma):
+    """S1(S_e) of eq. (27) and its derivative; C1 at |S_e| = sigma.
+
+    S1 = sig^alpha(S_e) for |S_e| > sigma, else beta1 S_e + beta2 sign(S_e) S_e^2.
+    """
+    b1, b2 = switch_coeffs(alpha, sigma)
+    return switch_c(se, alpha, sigma, b1, b2)
+
+
+# _nrt=False: compiled without Numba's reference counting. The law only reads and writes the
+# arrays its caller owns and allocates nothing, so the 8 array arguments need no incref/decref;
+# with it, each call paid 16 atomic updates (~0.1 us per call, 0.4 us per RK4 step). An
+# allocation added here fails to compile rather than leak. (_nrt is a private Numba option.)
+@njit(_nrt=False)
 def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FXTNTSMC law; status 1 if an error leaves its envelope.
 
     ``work[0:m]`` holds the RBF basis and ``work[ACC:ACC + 3]`` the commanded e_ddot.
     """
     att = attitude(eta[3], eta[4])
-    e, ed, f = error_state(eta, att, nu, refm, vp)
+    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
     kind, est, m = int(cp[ENV]), int(cp[EST]), int(cp[NEUR])
     if est != rbf.NONE:
         rbf.basis(e, ed, cp, CENT, m, cp[WIDTH], work)
     printed = cp[SURF] != 0.0
+    # the baseline's exp(-t / (T - t)) is shared by the three axes (one T)
+    shape = envelopes.AFTER_T
+    if kind != envelopes.NONE:
+        shape = envelopes.baseline_shape(t, cp[EP0])
+    bprinted = cp[EP0 + 7] != 0.0
+    eprm = envelopes.params(cp, EP0)
     for i in range(3):
-        status, tr = envelopes.axis_transform(kind, t, e[i], ed[i], X[XC + i], cp, EP0, i)
+        r1 = envelopes.baseline_from_shape(shape, cp[EP0 + 8 + i], cp[EP0 + 11 + i], bprinted)
+        status, tr = envelopes.axis_transform_given(kind, e[i], ed[i], X[XC + i], eprm, r1)
         if status != 0:
             return status
         z, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
-        se, dse = surface(z, cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL])
-        s1, dphi = switch(se, cp[ALPHA], cp[SIGMA])
+        se, dse = surface_c(z, cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2])
+        s1, dphi = switch_c(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2])
         S = zd + s1
         reach = -cp[K1] * sign(S) - cp[K2] * S * S * S - cp[K3] * S
         edd = (reach - dphi * dse * zd - Omd * ed[i] + c0 + U * ed[i]) / (Om - c1)
@@ -107,7 +171,8 @@ def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
         work[ACC + i] = edd - chat
         dX[XC + i] = rbd
         aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, chat, S, g, z
-    tau[0], tau[1], tau[2] = input_for_accel(att, nu, vp, f, (work[ACC], work[ACC + 1], work[ACC + 2]))
+    acc = (work[ACC], work[ACC + 1], work[ACC + 2])
+    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, acc, gf)
     return 0
 
 
@@ -157,9 +222,10 @@ def setup(scenario, ctx) -> CompiledController:
          SURFACES[p.surface], p.z_switch, p.z_floor, kind,
          env.T, env.delta, env.epsilon, env.lambda1, env.lambda2, env.lambda3, env.reactive_threshold,
          float(printed)], rho0, rho_inf,
+        surface_coeffs(p.a2, p.z_switch), switch_coeffs(p.alpha, p.sigma),
         [rbf.ESTIMATORS[est.kind], m, est.width], centres.ravel(),
     ]).astype(np.float64)
-    assert cp.size == CENT + 6 * m
+    assert cp.size == CENT + 6 * m and cp[EST] == rbf.ESTIMATORS[est.kind]
     xc0 = np.concatenate([rb0, weights.ravel()])
     resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
     return CompiledController(code=CODE, cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),

@@ -49,10 +49,12 @@ def estimate_and_adapt(X, off, m, psi, S_i, gain, dX):
     """
     chat, w2 = 0.0, 0.0
     for j in range(m):
-        chat += X[off + j] * psi[j]
-        w2 += X[off + j] * X[off + j]
+        k = np.uintp(off + j)  # unsigned index: no negative-index wraparound, so no gather/scatter
+        chat += X[k] * psi[j]
+        w2 += X[k] * X[k]
     for j in range(m):
-        dX[off + j] = gain * psi[j] * S_i - X[off + j] * w2
+        k = np.uintp(off + j)
+        dX[k] = gain * psi[j] * S_i - X[k] * w2
     return chat
 
 

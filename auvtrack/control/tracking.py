@@ -34,6 +34,17 @@ def error_state(eta, att, nu, refm, vp):
 
     ``refm`` rows are eta_d, eta_d_dot, eta_d_ddot; f is the input-free part of e_ddot.
     """
+    e, ed, f, _ = error_state_forces(eta, att, nu, refm, vp)
+    return e, ed, f
+
+
+@njit
+def error_state_forces(eta, att, nu, refm, vp):
+    """:func:`error_state` plus the nominal C nu + D nu + G of eq. (1) as a 5-tuple.
+
+    The forces are reused by :func:`input_for_accel_forces` at the same state (one evaluation
+    per controller call).
+    """
     ell = vp[ELL]
     u, v, w, q, r = nu[0], nu[1], nu[2], nu[3], nu[4]
     v1 = (u, q, r)
@@ -49,7 +60,7 @@ def error_state(eta, att, nu, refm, vp):
     jd = mat_vec(j3_dot(att, th_dot, ps_dot, ell), v1)
     d4d = j4_dot(att, v, w, th_dot, ps_dot, v_dot, w_dot)
     f = (jd[0] + d4d[0] - refm[2, 0], jd[1] + d4d[1] - refm[2, 1], jd[2] + d4d[2] - refm[2, 2])
-    return e, ed, f
+    return e, ed, f, g
 
 
 @njit
@@ -58,8 +69,13 @@ def input_for_accel(att, nu, vp, f, acc):
 
     v1_dot = J3^-1 (acc - f);  tau_bar = M_bar v1_dot + C_bar v1 + D_bar v1 + G_bar.
     """
+    return input_for_accel_forces(att, vp, f, acc, generalized_forces(att, nu, vp))
+
+
+@njit
+def input_for_accel_forces(att, vp, f, acc, g):
+    """:func:`input_for_accel` with g = generalized_forces(att, nu, vp) already evaluated."""
     a = mat_vec(j3_inv(att, vp[ELL]), (acc[0] - f[0], acc[1] - f[1], acc[2] - f[2]))
-    g = generalized_forces(att, nu, vp)
     return vp[M0] * a[0] + g[0], vp[M0 + 3] * a[1] + g[3], vp[M0 + 4] * a[2] + g[4]
 
 
@@ -85,6 +101,20 @@ def sig(x, p):
     if x < 0.0:
         return -((-x) ** p)
     return 0.0
+
+
+@njit
+def sig_pair(x, p):
+    """(sig^p(x), sig^(2-p)(x)) with one pow, for 1 < p < 2 (FTSMC).
+
+    With a = |x| and q = a^(p-1):  a^p = a q  and  a^(2-p) = a / q  (q >= min(a, 1): no overflow).
+    """
+    if not (x > 0.0 or x < 0.0):  # 0 (and NaN) -> 0, as sig
+        return 0.0, 0.0
+    a = abs(x)
+    q = a ** (p - 1.0)
+    s = 1.0 if x > 0.0 else -1.0
+    return s * (a * q), s * (a / q)
 
 
 @njit

@@ -20,7 +20,8 @@ Rate limits and noise act between control samples, so those factors run sampled-
 at ``SAMPLED_RATE`` = 500 Hz, the slowest rate at which both controllers complete the ideal
 Section 4 run (the FXTNTSMC fails it at 200 Hz and below, see the sampling factor).
 Steady state is the window ``[duration/2, duration]``.  Each run is seeded by the scenario
-seed (noise and current streams), so the study is reproducible.
+seed (noise and current streams), so the study is reproducible.  Every factor runs on each
+vehicle of ``VEHICLES`` (the paper's and the REMUS 100 preset).
 """
 from __future__ import annotations
 
@@ -38,6 +39,7 @@ from .registry import StudySpec
 from .report import Report, failure_cause, write_json
 
 CONTROLLERS = ("fxtntsmc", "ftsmc")
+VEHICLES = ("paper", "remus100")  # vehicle presets; every other number is Section 4's
 BASE_SIGMA_ETA = (0.01, 0.01, 0.01, math.radians(0.2), math.radians(0.2))
 BASE_SIGMA_NU = (0.01, 0.01, 0.01, math.radians(0.2), math.radians(0.2))
 TAU_SCALE = (500.0, 100.0, 100.0)
@@ -97,15 +99,19 @@ FACTORS = (
 )
 
 
-def _one(job: tuple[str, str, float, list[str]]) -> dict:
+Job = tuple[str, str, str, float, list[str]]  # vehicle, controller, factor, level, overrides
+
+
+def _one(job: Job) -> dict:
     from ..scenario import load_scenario
     from ..simulation.api import prepare, run_prepared
-    from .bench import paper_scenario_path
 
-    kind, factor, level, overrides = job
-    res = run_prepared(prepare(load_scenario(paper_scenario_path(), [f"controller.kind={kind}", *overrides])))
+    vehicle, kind, factor, level, overrides = job
+    # the built-in defaults are Section 4; the preset then supplies every vehicle number
+    sc = load_scenario({}, [f"vehicle.preset={vehicle}", f"controller.kind={kind}", *overrides])
+    res = run_prepared(prepare(sc))
     m = res.metrics
-    row = {"controller": kind, "factor": factor, "level": level, "status": res.status,
+    row = {"vehicle": vehicle, "controller": kind, "factor": factor, "level": level, "status": res.status,
            "cause": failure_cause(res),
            "fail_time": res.failure["time"] if res.failure else None}
     for key in ("rmse_x", "rmse_y", "rmse_z", "max_abs_x", "max_abs_y", "max_abs_z",
@@ -119,8 +125,8 @@ def _one(job: tuple[str, str, float, list[str]]) -> dict:
     return row
 
 
-def jobs(duration: float, factors=FACTORS) -> list[tuple[str, str, float, list[str]]]:
-    """Every (controller, factor, level, overrides) run of the study, the ideal loop first.
+def jobs(duration: float, factors=FACTORS, vehicles=VEHICLES) -> list[Job]:
+    """Every (vehicle, controller, factor, level, overrides) run of the study, ideal loops first.
 
     Parameters
     ----------
@@ -128,16 +134,20 @@ def jobs(duration: float, factors=FACTORS) -> list[tuple[str, str, float, list[s
         Simulated seconds per run; metrics use the window ``[duration/2, duration]``.
     factors : sequence of Factor, optional
         Factors and levels to run.
+    vehicles : sequence of str, optional
+        Vehicle presets.
 
     Returns
     -------
     list of tuple
-        ``(controller, factor name, level, overrides)``; the factor ``"ideal"`` is the baseline.
+        ``(vehicle, controller, factor name, level, overrides)``; factor ``"ideal"`` is the baseline.
     """
     common = [f"sim.duration={duration:g}", f"metrics.window=[{duration / 2:g}, {duration:g}]"]
-    out = [(k, "ideal", 0.0, common) for k in CONTROLLERS]
-    for f in factors:
-        out += [(k, f.name, lv, common + f.to_overrides(lv)) for k in CONTROLLERS for lv in f.levels]
+    out: list[Job] = []
+    for v in vehicles:
+        out += [(v, k, "ideal", 0.0, common) for k in CONTROLLERS]
+        for f in factors:
+            out += [(v, k, f.name, lv, common + f.to_overrides(lv)) for k in CONTROLLERS for lv in f.levels]
     return out
 
 
@@ -167,15 +177,17 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
         rows = list(tqdm(pool.map(_one, todo), total=len(todo), disable=not progress, desc="realism"))
     write_json(out / "results.json", {"duration_s": duration, "rows": rows})
     rep = Report(out, "Realism: degradation away from the ideal loop")
-    rep.paragraph(f"Section 4 with one factor changed at a time; {duration:g} s runs, steady-state window "
+    rep.paragraph(f"Section 4 with one factor changed at a time, on the vehicles {', '.join(VEHICLES)}; "
+                  f"{duration:g} s runs, steady-state window "
                   f"[{duration / 2:g}, {duration:g}] s. `rmse` is the norm of the per-axis steady RMSE (m); "
                   "`tv_tau` the summed total variation of the inputs per second. A failed run gives its cause "
                   "and time; its metrics cover the part it ran.")
-    rep.figure(_figure(rows, factors), "degradation", "steady RMSE and input activity against each factor "
-               "(dotted vertical line: a failed run)")
+    for v in VEHICLES:
+        rep.figure(_figure([r for r in rows if r["vehicle"] == v], factors), f"degradation_{v}",
+                   f"vehicle {v}: steady RMSE and input activity against each factor (dotted line: a failed run)")
     rep.heading("Runs")
-    rep.table(["factor", "level", "controller", "status", "rmse (m)", "max |e_x| (m)", "tv_tau"],
-              [[r["factor"], r["level"], r["controller"],
+    rep.table(["vehicle", "factor", "level", "controller", "status", "rmse (m)", "max |e_x| (m)", "tv_tau"],
+              [[r["vehicle"], r["factor"], r["level"], r["controller"],
                 "ok" if r["status"] == "ok" else f"failed: {r['cause']} at {r['fail_time']:.3g} s",
                 r["rmse"], r["max_abs_x"], r["tv_tau"]] for r in rows], digits=3)
     rep.heading("Failures by cause")
@@ -185,11 +197,12 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
 
 def _failure_summary(rows: list[dict]) -> list[str]:
     out = []
-    for kind in CONTROLLERS:
-        mine = [r for r in rows if r["controller"] == kind]
-        causes = Counter(r["cause"] for r in mine if r["status"] != "ok")
-        text = f"{kind}: {sum(causes.values())} of {len(mine)} runs failed"
-        out.append(text + (": " + ", ".join(f"{c} × {k}" for c, k in sorted(causes.items())) if causes else ""))
+    for v in VEHICLES:
+        for kind in CONTROLLERS:
+            mine = [r for r in rows if r["controller"] == kind and r["vehicle"] == v]
+            causes = Counter(r["cause"] for r in mine if r["status"] != "ok")
+            text = f"{v}, {kind}: {sum(causes.values())} of {len(mine)} runs failed"
+            out.append(text + (": " + ", ".join(f"{c} × {k}" for c, k in sorted(causes.items())) if causes else ""))
     return out
 
 

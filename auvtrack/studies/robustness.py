@@ -19,7 +19,6 @@ and 95th percentile of the metrics over the runs that did not fail.
 """
 from __future__ import annotations
 
-import json
 import math
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -32,7 +31,7 @@ import numpy as np
 from ..scenario import load_scenario
 from ..simulation.api import prepare, run_prepared
 from .registry import StudySpec
-from .report import failure_cause
+from .report import failure_cause, write_json
 
 __all__ = ["Sample", "RobustnessConfig", "CONTROLLERS", "draw_samples", "sample_scenario",
            "run_batch", "summarise", "run", "STUDY"]
@@ -298,16 +297,6 @@ def _report(summary: dict, cfg: RobustnessConfig, quick: bool, wall: float, skip
     return "\n".join(lines)
 
 
-def _clean(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if isinstance(x, float) and not math.isfinite(x):
-        return None if math.isnan(x) else ("inf" if x > 0 else "-inf")
-    return x
-
-
 def run(out: Path, *, quick: bool = False, progress: bool = False,
         config: RobustnessConfig | None = None) -> Path:
     """Run the Monte Carlo study and write ``report.md``, ``runs.csv`` and ``results.json``.
@@ -358,8 +347,8 @@ def run(out: Path, *, quick: bool = False, progress: bool = False,
     df = pd.DataFrame(rows)
     df["eta0"] = df["eta0"].map(lambda e: " ".join(f"{x:.6g}" for x in e))
     df.to_csv(out / "runs.csv", index=False)
-    (out / "results.json").write_text(json.dumps(_clean(
-        {"config": asdict(cfg), "quick": quick, "controllers": controllers, "summary": summary}), indent=2))
+    write_json(out / "results.json", (
+        {"config": asdict(cfg), "quick": quick, "controllers": controllers, "summary": summary}))
     report = out / "report.md"
     report.write_text(_report(summary, cfg, quick, wall, skipped))
     return report

@@ -35,6 +35,7 @@ from ..control.theory import check_theorem1
 from ..scenario import load_scenario
 from ..simulation.api import prepare, run_prepared
 from .registry import StudySpec
+from .report import write_json
 
 __all__ = ["GainSpace", "Objective", "Case", "Budget", "SPACES", "TRAIN_CASES", "HELDOUT_CASES",
            "case_scenario", "run_cost", "tune", "evaluate", "preset_toml", "run", "STUDY"]
@@ -519,17 +520,6 @@ def _report(results: dict[str, TuneResult], evals: dict, budget: Budget, objecti
     return "\n".join(lines)
 
 
-def _clean(x: Any) -> Any:
-    """JSON-safe copy: non-finite floats become null, tuples lists."""
-    if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     """Tune both controllers, evaluate on held-out scenarios, write presets and a report.
 
@@ -572,10 +562,10 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     evals = {"columns": columns, "rows": rows}
     for kind, r in results.items():
         (out / f"{kind}_tuned.toml").write_text(preset_toml(r, budget, objective))
-    (out / "results.json").write_text(json.dumps(_clean(
+    write_json(out / "results.json", (
         {"budget": asdict(budget), "objective": asdict(objective), "quick": quick,
          "train_cases": [asdict(c) for c in train], "heldout_cases": [asdict(c) for c in heldout],
-         "results": {k: asdict(r) for k, r in results.items()}, "evaluation": rows}), indent=2))
+         "results": {k: asdict(r) for k, r in results.items()}, "evaluation": rows}))
     report = out / "report.md"
     report.write_text(_report(results, evals, budget, objective, quick, heldout))
     return report
