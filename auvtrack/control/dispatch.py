@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from numba import literally
 
-from .._jit import njit
+from .._jit import njit_noalloc
 from . import ftsmc, fxtntsmc, open_loop
 from .dispatch_layout import NX_PLANT, WORK_SIZE  # noqa: F401  (re-exported)
 
@@ -39,7 +39,7 @@ CONTROLLER_STATUS = {
 }
 
 
-@njit(_nrt=False)  # no reference counting of the 8 array arguments (it allocates nothing): ~0.4 us/step
+@njit_noalloc
 def control(code, t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
     """Evaluate controller ``code`` (a compile-time literal); unknown codes return status 99."""
     literally(code)

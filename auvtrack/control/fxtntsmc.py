@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, njit_noalloc
 from . import envelopes, rbf
 from .registry import CompiledController
 from ..plant.kinematics import attitude
@@ -131,11 +131,7 @@ def switch(se, alpha, sigma):
     return switch_c(se, alpha, sigma, b1, b2)
 
 
-# _nrt=False: compiled without Numba's reference counting. The law only reads and writes the
-# arrays its caller owns and allocates nothing, so the 8 array arguments need no incref/decref;
-# with it, each call paid 16 atomic updates (~0.1 us per call, 0.4 us per RK4 step). An
-# allocation added here fails to compile rather than leak. (_nrt is a private Numba option.)
-@njit(_nrt=False)
+@njit_noalloc  # allocates nothing: no reference counting of its 8 array arguments (_jit.py)
 def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FXTNTSMC law; status 1 if an error leaves its envelope.
 

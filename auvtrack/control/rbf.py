@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit_noalloc
 from .._seeding import rng
 
 NONE, PRINTED, OMEGA = 0, 1, 2
@@ -25,7 +25,7 @@ ESTIMATORS = {"none": NONE, "printed": PRINTED, "omega": OMEGA}
 N_INPUT = 6
 
 
-@njit
+@njit_noalloc
 def basis(e, ed, cp, off, m, width, psi):
     """Gaussian basis psi(x) of eq. (12), x = [e, e_dot], written to psi[0:m].
 
@@ -41,7 +41,7 @@ def basis(e, ed, cp, off, m, width, psi):
         psi[j] = math.exp(-d2 * inv)
 
 
-@njit
+@njit_noalloc
 def estimate_and_adapt(X, off, m, psi, S_i, gain, dX):
     """chi_hat_i = W^T psi (eq. 33) with W = X[off : off + m]; dX gets W_dot (eq. 34).
 

@@ -14,7 +14,7 @@ All functions are compiled and work on tuples (see :mod:`auvtrack.plant.kinemati
 """
 from __future__ import annotations
 
-from .._jit import njit
+from .._jit import njit, njit_noalloc
 from ..plant.dynamics import generalized_forces
 from ..plant.kinematics import j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
 from ..plant.params import ELL, M0
@@ -28,7 +28,7 @@ def mat_vec(A, x):
             A[2][0] * x[0] + A[2][1] * x[1] + A[2][2] * x[2])
 
 
-@njit
+@njit_noalloc
 def error_state(eta, att, nu, refm, vp):
     """Return (e, e_dot, f) as 3-tuples for the nominal model ``vp`` (eq. 14-15).
 
@@ -38,7 +38,7 @@ def error_state(eta, att, nu, refm, vp):
     return e, ed, f
 
 
-@njit
+@njit_noalloc
 def error_state_forces(eta, att, nu, refm, vp):
     """:func:`error_state` plus the nominal C nu + D nu + G of eq. (1) as a 5-tuple.
 
@@ -63,7 +63,7 @@ def error_state_forces(eta, att, nu, refm, vp):
     return e, ed, f, g
 
 
-@njit
+@njit_noalloc
 def input_for_accel(att, nu, vp, f, acc):
     """Nominal input tau_bar = (tau_u, tau_q, tau_r) giving e_ddot = acc (ERRATA 13 route).
 
@@ -72,7 +72,7 @@ def input_for_accel(att, nu, vp, f, acc):
     return input_for_accel_forces(att, vp, f, acc, generalized_forces(att, nu, vp))
 
 
-@njit
+@njit_noalloc
 def input_for_accel_forces(att, vp, f, acc, g):
     """:func:`input_for_accel` with g = generalized_forces(att, nu, vp) already evaluated."""
     a = mat_vec(j3_inv(att, vp[ELL]), (acc[0] - f[0], acc[1] - f[1], acc[2] - f[2]))

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import lfilter
 
-from .._jit import njit
+from .._jit import njit_noalloc
 from ..plant.params import D0
 from . import _validate as val
 from .layout import C_DT, C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, ROW_SIZE
@@ -126,7 +126,7 @@ class GaussMarkovCurrent:
         return row
 
 
-@njit
+@njit_noalloc
 def current_velocity(rows, r, current, t):
     """Interpolated current V_c(t) (m/s, NED) of packed row ``r``: returns (Vx, Vy, Vz).
 
@@ -148,7 +148,7 @@ def current_velocity(rows, r, current, t):
             current[k, 3] + f * (current[k + 1, 3] - current[k, 3]))
 
 
-@njit
+@njit_noalloc
 def add_current_force(vx, vy, vz, eta, vp, out):
     """Add omega[0:3] = diag(d11, d22, d33) J1(theta, psi)^T V_c (N) to ``out`` (5,)."""
     ct, st = math.cos(eta[3]), math.sin(eta[3])

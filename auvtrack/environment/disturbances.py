@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit_noalloc
 from . import _validate as val
 from .layout import KIND_PAPER, KIND_PULSE, P_AMP, P_PHASE, ROW_SIZE, U_END, U_FORCE, U_START
 
@@ -99,7 +99,7 @@ class Pulse:
         return row
 
 
-@njit
+@njit_noalloc
 def add_paper(rows, k, t, out):
     """Add the paper's disturbance of packed row ``k`` at time ``t`` (s) to ``out`` (5,)."""
     a, p = rows[k, P_AMP], rows[k, P_PHASE]
@@ -112,7 +112,7 @@ def add_paper(rows, k, t, out):
     out[4] += a * (s1 + c1)
 
 
-@njit
+@njit_noalloc
 def add_pulse(rows, k, t, out):
     """Add the pulse of packed row ``k`` to ``out`` (5,) when ``start <= t < end``."""
     if rows[k, U_START] <= t < rows[k, U_END]:

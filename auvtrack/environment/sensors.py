@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._seeding import rng
-from .._jit import njit
+from .._jit import njit_noalloc
 
 N_MEAS = 10
 
@@ -59,7 +59,7 @@ def noise_table(seed: int, n_samples: int, sigma) -> np.ndarray:
     return rng(seed, "sensor").standard_normal((n_samples, N_MEAS)) * s
 
 
-@njit
+@njit_noalloc
 def measure(X, noise, k):
     """Measured (eta, nu) 5-tuples at control sample ``k`` (row ``k`` of ``noise``; no rows: exact)."""
     if noise.shape[0] == 0:

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, njit_noalloc
 from .._seeding import rng
 from ..plant.params import VP_SIZE
 from .current import GaussMarkovCurrent, add_current_force, current_velocity
@@ -27,7 +27,7 @@ from .layout import C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, KIND_PAPER, KIND_PULS
 COMPONENT_TYPES = (PaperDisturbance, Pulse, GaussMarkovCurrent)
 
 
-@njit
+@njit_noalloc
 def eval_disturbance(rows, current, t, eta, nu, vp, out):
     """Write the total disturbance omega(t) (5,) into ``out``: N (surge, sway, heave), N m (q, r).
 

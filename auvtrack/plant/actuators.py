@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, njit_noalloc
 
 ACT_TAU_MAX, ACT_RATE_MAX = 0, 3
 ACT_SIZE = 6
@@ -31,14 +31,14 @@ def _clip(x, lo, hi):
     return lo if x < lo else (hi if x > hi else x)
 
 
-@njit
+@njit_noalloc
 def saturate(tau3, p, off):
     """Clip each input to ``[-tau_max_j, tau_max_j]`` (limits at ``p[off:off+3]``); a 3-tuple."""
     m0, m1, m2 = p[off + ACT_TAU_MAX], p[off + ACT_TAU_MAX + 1], p[off + ACT_TAU_MAX + 2]
     return _clip(tau3[0], -m0, m0), _clip(tau3[1], -m1, m1), _clip(tau3[2], -m2, m2)
 
 
-@njit
+@njit_noalloc
 def rate_limit(tau3, prev3, p, off, h):
     """Move from ``prev3`` towards ``tau3`` by at most ``rate_max_j * h`` per input (3-tuple)."""
     d0 = p[off + ACT_RATE_MAX] * h

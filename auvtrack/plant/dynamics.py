@@ -13,11 +13,11 @@ Vectors are tuples (see :mod:`auvtrack.plant.kinematics`).
 """
 from __future__ import annotations
 
-from .._jit import njit
+from .._jit import njit_noalloc
 from .params import CSCALE, D0, M0, WGML
 
 
-@njit
+@njit_noalloc
 def generalized_forces(att, nu, vp):
     """C(nu) nu + D nu + G(eta) of eq. (1) as a 5-tuple (N, N m); ``att`` gives sin(theta)."""
     u, v, w, q, r = nu[0], nu[1], nu[2], nu[3], nu[4]
@@ -30,7 +30,7 @@ def generalized_forces(att, nu, vp):
             c * ((m22 - m11) * u * v) + vp[D0 + 4] * r)
 
 
-@njit
+@njit_noalloc
 def nu_dot(att, nu, tau3, omega, vp):
     """Kinetics eq. (1): d/dt nu (5-tuple) for input tau3 = (tau_u, tau_q, tau_r)."""
     g = generalized_forces(att, nu, vp)

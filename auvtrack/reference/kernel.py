@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, njit_noalloc
 
 FAMILY_SEGMENTS = 1
 H_FAMILY, H_LEN, H_NSEG, H_STRIDE = 0, 1, 2, 3
@@ -40,7 +40,7 @@ NCOEF = 6  # c0, c1, c2, c3, A, B per axis
 SEG = 1 + 3 * NCOEF
 
 
-@njit
+@njit_noalloc
 def eval_reference(ref_p, t, out):
     """Evaluate a packed reference at time ``t``.
 

@@ -27,7 +27,7 @@ import math
 import numpy as np
 from numba import literally
 
-from .._jit import njit
+from .._jit import njit, njit_noalloc
 from ..control import ftsmc, fxtntsmc, open_loop
 from ..control.dispatch import NX_PLANT, WORK_SIZE, control
 from ..control.tracking import lumped_disturbance
@@ -60,13 +60,13 @@ STATUS_NONFINITE_INPUT = 3
 assert (ftsmc.CODE, fxtntsmc.CODE, open_loop.CODE) == (1, 2, 3), "update run_kernel's branches"
 
 
-@njit
+@njit_noalloc
 def plant_state(X):
     """(eta, nu) tuples of the plant part of X."""
     return (X[0], X[1], X[2], X[3], X[4]), (X[5], X[6], X[7], X[8], X[9])
 
 
-@njit
+@njit_noalloc
 def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, dX, tau, aux,
                     refm, omega, work, att, fresh, sf):
     """Write dX/dt; return 0 or a controller status.  ``hold`` = [tau (3), dxc] in sampled mode.
@@ -125,7 +125,7 @@ def _log_row(log, row, t, X, tau, refm, e, aux, naux, dX, vp_nom):
     log[row, 20 + naux], log[row, 21 + naux], log[row, 22 + naux] = chi
 
 
-@njit
+@njit_noalloc
 def _state_cause(X, theta_lim, state_lim):
     """Failure cause of a state (precedence: non-finite, pitch, state limit), one pass."""
     nonfinite = over = False
@@ -144,7 +144,7 @@ def _state_cause(X, theta_lim, state_lim):
     return CAUSE_NONE
 
 
-@njit
+@njit_noalloc
 def _finite3(v):
     return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
 

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from .._jit import njit
+from .._jit import njit, njit_noalloc
 
 AXES = ("x", "y", "z")
 INPUTS = ("u", "q", "r")
@@ -62,7 +62,7 @@ def metrics_init(acc):
         acc[OFF_SETTLE + i] = np.nan
 
 
-@njit
+@njit_noalloc
 def metrics_update(acc, t, dt, e, tau, t0, t1):
     """Add one integration step (left-point values) to the accumulator; allocation-free.
 
