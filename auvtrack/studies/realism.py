@@ -232,4 +232,4 @@ def _figure(rows: list[dict], factors) -> Figure:
     return fig
 
 
-STUDY = StudySpec("realism", run, "saturation, rate limits, 10-100 Hz sampling, sensor noise, currents")
+STUDY = StudySpec("realism", run, "saturation, rate limits, 10 Hz - 1 kHz sampled control, sensor noise, currents; paper and remus100")
