@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from auvtrack.control import envelopes as E
@@ -24,6 +24,7 @@ def test_baseline_starts_at_rho0_and_is_smooth_at_T():
 
 
 @settings(max_examples=50)
+@example(0.0, 0.01, 0.001)  # (rho0 - rinf) + rinf rounded above rho0 before the clamp
 @given(st.floats(0.0, 14.9), st.floats(0.01, 10.0), st.floats(1e-4, 0.009))
 def test_baseline_derivatives_by_finite_differences(t, rho0, rinf):
     h = 1e-6
@@ -33,7 +34,7 @@ def test_baseline_derivatives_by_finite_differences(t, rho0, rinf):
     if t > h:
         assert abs((rp - rm) / (2 * h) - d1) <= 1e-6 * max(1.0, abs(d1))
         assert abs((d1p - d1m) / (2 * h) - d2) <= 1e-5 * max(1.0, abs(d2))
-    assert rinf <= r <= rho0 * (1 + 4 * np.finfo(float).eps)  # (rho0 - rinf) + rinf may round up by an ulp
+    assert rinf <= r <= rho0
 
 
 def test_risk_indicator_is_c1_and_matches_eq22():

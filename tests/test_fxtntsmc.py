@@ -7,7 +7,7 @@ import pytest
 import auvtrack
 from auvtrack.control.fxtntsmc import StartOutsideEnvelope, surface, switch
 from auvtrack.scenario import load_scenario
-from auvtrack.simulation.api import prepare, run_prepared
+from auvtrack.simulation.api import prepare
 
 PAPER = "scenarios/paper.toml"
 IDEAL = ["uncertainty.C=0", "uncertainty.D=0", "disturbance=[]", "estimator.kind=none",

@@ -105,8 +105,11 @@ def test_sensor_noise_is_seeded_and_only_the_controller_sees_it():
     np.testing.assert_array_equal(a["tau_u"], b["tau_u"])
     assert not np.array_equal(a["tau_u"], clean["tau_u"]) and not np.array_equal(a["tau_u"], c["tau_u"])
     assert np.array_equal(a["t"], clean["t"]) and np.all(np.isfinite(a["x"]))
-    # the logged state is the true one: its virtual-point error is consistent with the log
-    np.testing.assert_allclose(a["xd"], clean["xd"], rtol=0, atol=0)
+    # logs hold the true state: the logged error is eq. (2) of the logged state (ell = 1 m), to
+    # rounding, while 1 mm of measurement noise would show as millimetres here
+    th, ps = a["theta"], a["psi"]
+    np.testing.assert_allclose(a["ex"], a["x"] + np.cos(th) * np.cos(ps) - a["xd"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(a["ez"], a["z"] - np.sin(th) - a["zd"], rtol=0, atol=1e-12)
 
 
 def test_ideal_actuator_and_sensor_change_nothing():
@@ -134,3 +137,30 @@ def test_realism_study_quick(tmp_path):
     assert all(r["rmse"] < 0.05 for r in ideal if r["vehicle"] == "paper")
     text = report.read_text()
     assert "Failures by cause" in text and (tmp_path / "figures" / "degradation_remus100.png").exists()
+
+
+@pytest.mark.parametrize("override, field", [
+    ("actuator.rate_max=[100, 100, 100]", "actuator.rate_max"),
+    ("sensor.sigma_eta=[0.001, 0, 0, 0, 0]", "sensor"),
+    ("sensor.sigma_nu=[0, 0, 0, 0, 0.01]", "sensor"),
+])
+def test_rate_limit_and_noise_need_a_control_rate(override, field):
+    from auvtrack.scenario import ScenarioError, load_scenario
+
+    with pytest.raises(ScenarioError) as err:
+        load_scenario({}, [override])
+    msg = str(err.value)
+    assert "\n" not in msg and field in msg and "control_rate > 0" in msg
+    load_scenario({}, [override, "sim.control_rate=100"])  # with sampled control it is accepted
+
+
+def test_actuator_limits_broadcast_round_trip_and_refuse_non_positive():
+    from auvtrack.scenario import ScenarioError, load_scenario
+
+    sc = load_scenario({}, ["actuator.tau_max=200"])
+    assert sc.actuator.tau_max == (200.0, 200.0, 200.0) and sc.actuator.rate_max == (math.inf,) * 3
+    d = sc.to_dict()
+    assert d["actuator"]["rate_max"] == ["inf"] * 3 and load_scenario(d) == sc
+    for bad in ("actuator.tau_max=[0, 1, 1]", "actuator.rate_max=[1, -1, 1]", "actuator.tau_max=[nan, 1, 1]"):
+        with pytest.raises(ScenarioError, match="actuator"):
+            load_scenario({}, [bad])

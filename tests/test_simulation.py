@@ -1,5 +1,4 @@
 """The compiled closed-loop engine: integrator order, modes, logging, determinism, failures."""
-import warnings
 
 import numpy as np
 import pytest

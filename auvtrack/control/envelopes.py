@@ -68,7 +68,8 @@ def baseline_from_shape(shape, rho0, rho_inf, printed):
     if state == 1:
         return (0.0 if printed else rho_inf), 0.0, 0.0
     a = (rho0 - rho_inf) * ex
-    r = a if printed else a + rho_inf
+    # rho_inf <= rho1 <= rho0 exactly: (rho0 - rho_inf) + rho_inf can round one ulp above rho0
+    r = a if printed else min(a + rho_inf, rho0)
     return r, a * d1, a * d11
 
 
@@ -125,8 +126,17 @@ def solve_risk_loop(h0, k, eps):
     return g
 
 
+# packed envelope parameters ep[off : off + N_PARAMS]
+EP_T, EP_DELTA, EP_EPS, EP_LAM1, EP_LAM2, EP_LAM3, EP_THR, EP_PRINTED, EP_RHO0, EP_RHOINF = (
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 11)  # rho0 and rho_inf take 3 slots each (x, y, z)
 N_PARAMS = 14
 OUTSIDE = (math.nan,) * 11
+
+
+@njit
+def axis_baseline(shape, ep, off, i):
+    """rho1, rho1_dot, rho1_ddot of eq. (24) for axis ``i`` from :func:`baseline_shape`."""
+    return baseline_from_shape(shape, ep[off + EP_RHO0 + i], ep[off + EP_RHOINF + i], ep[off + EP_PRINTED] != 0.0)
 
 
 @njit
@@ -142,7 +152,7 @@ def axis_transform(kind, t, e, ed, rb, ep, off, i):
     prm = params(ep, off)
     if kind == NONE:
         return axis_transform_given(kind, e, ed, rb, prm, (math.nan, 0.0, 0.0))
-    r1 = baseline(t, ep[off + 8 + i], ep[off + 11 + i], ep[off], ep[off + 7] != 0.0)
+    r1 = axis_baseline(baseline_shape(t, ep[off + EP_T]), ep, off, i)
     return axis_transform_given(kind, e, ed, rb, prm, r1)
 
 
@@ -157,7 +167,8 @@ def _tanh_and_slope(a, lam3):
 @njit
 def params(ep, off):
     """(delta, eps, lambda1, lambda2, lambda3, thr) from ``ep[off : off + 14]`` as a tuple."""
-    return ep[off + 1], ep[off + 2], ep[off + 3], ep[off + 4], ep[off + 5], ep[off + 6]
+    return (ep[off + EP_DELTA], ep[off + EP_EPS], ep[off + EP_LAM1], ep[off + EP_LAM2], ep[off + EP_LAM3],
+            ep[off + EP_THR])
 
 
 @njit

@@ -146,11 +146,10 @@ def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
     # the baseline's exp(-t / (T - t)) is shared by the three axes (one T)
     shape = envelopes.AFTER_T
     if kind != envelopes.NONE:
-        shape = envelopes.baseline_shape(t, cp[EP0])
-    bprinted = cp[EP0 + 7] != 0.0
+        shape = envelopes.baseline_shape(t, cp[EP0 + envelopes.EP_T])
     eprm = envelopes.params(cp, EP0)
     for i in range(3):
-        r1 = envelopes.baseline_from_shape(shape, cp[EP0 + 8 + i], cp[EP0 + 11 + i], bprinted)
+        r1 = envelopes.axis_baseline(shape, cp, EP0, i)
         status, tr = envelopes.axis_transform_given(kind, e[i], ed[i], X[XC + i], eprm, r1)
         if status != 0:
             return status

@@ -138,10 +138,10 @@ def prepare(scenario: Scenario) -> Prepared:
     sf = np.concatenate([[dt, math.radians(sc.sim.theta_limit), sc.sim.state_limit, t0,
                           t1 if math.isfinite(t1) else 1e300],
                          pack_actuator(sc.actuator.tau_max, sc.actuator.rate_max)])
-    n_samples = n_steps // ctrl_every + 1 if ctrl_every > 0 else 0
-    noise = noise_table(sc.seed, max(n_samples, 1), (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu))
-    if ctrl_every == 0 and noise.shape[0]:  # the schema refuses this; never integrate noise silently
+    sigma = (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu)
+    if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
+    noise = noise_table(sc.seed, n_steps // ctrl_every + 1 if ctrl_every else 1, sigma)
     X0 = np.concatenate([eta0, nu0, cc.xc0]).astype(np.float64)
     return Prepared(sc, X0, si, sf, np.ascontiguousarray(cc.cp, dtype=np.float64), vp_nom, vp_true,
                     ref_p, tables.rows, tables.current, noise, n_steps // log_every + 1,

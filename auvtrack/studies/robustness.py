@@ -13,7 +13,7 @@ seed, so a sample set is a pure function of ``(seed, n)``):
 
 Every controller configuration sees the *same* samples (common random numbers), on every
 vehicle preset of the configuration (``paper`` and ``remus100`` by default).  Runs go through
-``run_prepared`` in a ``ThreadPoolExecutor`` (the compiled kernel releases the GIL).  The report
+:func:`auvtrack.simulation.batch.run_batch` (threads over the ``nogil`` kernel).  The report
 gives, per vehicle and controller, the failure rate with the failures by cause, and the median
 and 95th percentile of the metrics over the runs that did not fail.
 """
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import math
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Sequence
@@ -29,7 +28,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..scenario import load_scenario
-from ..simulation.api import prepare, run_prepared
+from ..simulation.api import prepare
+from ..simulation.batch import run_batch
 from .registry import StudySpec
 from .report import failure_cause, write_json
 
@@ -201,26 +201,6 @@ def _record(res, duration: float) -> dict[str, Any]:
     return rec
 
 
-def run_batch(scenarios: Sequence[dict], workers: int = 2) -> list:
-    """Validate and prepare every scenario, then run them in ``workers`` threads (order kept).
-
-    Parameters
-    ----------
-    scenarios : sequence of dict
-        Scenario dicts.
-    workers : int, optional
-        Threads (the compiled kernel releases the GIL).
-
-    Returns
-    -------
-    list of Result
-        In the order of ``scenarios``.
-    """
-    preps = [prepare(load_scenario(sc)) for sc in scenarios]
-    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-        return list(pool.map(run_prepared, preps))
-
-
 def summarise(records: Sequence[dict]) -> dict[str, Any]:
     """Failure rate, failures by cause, and median / 95th percentile of each quantity.
 
@@ -334,7 +314,8 @@ def run(out: Path, *, quick: bool = False, progress: bool = False,
         for label, kind, preset in controllers:
             t0 = time.perf_counter()
             scs = [sample_scenario(s, vehicle, kind, preset, cfg.duration, cfg.dt) for s in samples]
-            recs = [_record(r, cfg.duration) for r in run_batch(scs, cfg.workers)]
+            results = run_batch([prepare(load_scenario(sc)) for sc in scs], trajectories=True, workers=cfg.workers)
+            recs = [_record(r, cfg.duration) for r in results]
             for s, rec in zip(samples, recs):
                 rows.append({"vehicle": vehicle, "controller": label, **asdict(s), **rec})
             summary[vehicle][label] = summarise(recs)
