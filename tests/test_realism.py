@@ -164,3 +164,37 @@ def test_actuator_limits_broadcast_round_trip_and_refuse_non_positive():
     for bad in ("actuator.tau_max=[0, 1, 1]", "actuator.rate_max=[1, -1, 1]", "actuator.tau_max=[nan, 1, 1]"):
         with pytest.raises(ScenarioError, match="actuator"):
             load_scenario({}, [bad])
+
+
+@pytest.mark.parametrize("kind", ["ftsmc", "fxtntsmc"])
+def test_sampled_law_uses_the_attitude_of_the_measured_state(kind):
+    """The engine hands the law attitude(measured theta, psi), not that of the true state."""
+    from auvtrack.control.dispatch import WORK_SIZE, control
+    from auvtrack.plant.kinematics import attitude
+    from auvtrack.scenario import load_scenario
+    from auvtrack.simulation.api import prepare, run_prepared
+    from auvtrack.simulation.engine import SI_CODE
+
+    sc = load_scenario({}, ["sim.duration=0.05", "sim.control_rate=100", f"controller.kind={kind}",
+                            "sensor.sigma_eta=[0, 0, 0, 0.05, 0.05]"])
+    p = prepare(sc)
+    first = run_prepared(p).to_pandas().iloc[0]  # the input applied on [0, 10 ms) is the law at sample 0
+    eta, nu = measure(p.X0, p.noise, 0)
+
+    def law(att):
+        tau, dX, aux, work = np.zeros(3), np.zeros(p.X0.size), np.zeros(64), np.zeros(WORK_SIZE)
+        assert control(int(p.si[SI_CODE]), 0.0, eta, nu, att, p.X0, _ref0(p), p.vp_nom, p.cp, tau, dX, aux, work) == 0
+        return tau
+
+    measured, true = law(attitude(eta[3], eta[4])), law(attitude(p.X0[3], p.X0[4]))
+    applied = first[["tau_u", "tau_q", "tau_r"]].to_numpy(float)
+    np.testing.assert_array_equal(applied, measured)
+    assert np.abs(measured - true).max() > 1e-6 * np.abs(measured).max()  # the test can tell them apart
+
+
+def _ref0(p):
+    from auvtrack.reference import eval_reference
+
+    refm = np.zeros((3, 3))
+    eval_reference(p.ref_p, 0.0, refm)
+    return refm

@@ -329,3 +329,25 @@ def test_packaged_copy_matches():
     if not packaged.exists():
         pytest.skip("no packaged copy")
     assert load_scenario(packaged) == load_scenario(PAPER)
+
+
+def test_read_toml_sees_an_edit_and_hands_out_independent_copies(tmp_path):
+    """Parsed files are cached by content: an edit of the same size is read again, and a caller
+    mutating its dict does not change what the next caller gets."""
+    from auvtrack.scenario import read_toml
+
+    f = tmp_path / "s.toml"
+    f.write_text('name = "a"\nseed = 1\n')
+    first = read_toml(f)
+    first["seed"] = 99
+    assert read_toml(f) == {"name": "a", "seed": 1}
+    f.write_text('name = "b"\nseed = 2\n')  # same size, possibly the same mtime
+    assert read_toml(f) == {"name": "b", "seed": 2}
+
+
+def test_vehicle_presets_are_independent_copies():
+    from auvtrack.plant.presets import get_preset
+
+    a = get_preset("paper")
+    a.sources["m"]["source"] = "changed"
+    assert get_preset("paper").sources["m"]["source"] != "changed"

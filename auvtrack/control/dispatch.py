@@ -2,11 +2,13 @@
 
 Every controller's compiled law has the signature
 
-    control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work) -> int status
+    control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work) -> int status
 
 =======  ==============================================================================
 t        time (s)
 eta, nu  measured state, 5-tuples (see :mod:`auvtrack.plant.kinematics`)
+att      attitude(eta[3], eta[4]) = (cos theta, sin theta, cos psi, sin psi) of the measured
+         state, computed once by the engine (the plant's right-hand side needs it too)
 X        full state; the controller's internal state is X[NX_PLANT:] (read only)
 refm     (3, 3) rows eta_d, eta_d_dot, eta_d_ddot
 vp       packed *nominal* vehicle parameters (the controller never sees the true plant)
@@ -40,13 +42,13 @@ CONTROLLER_STATUS = {
 
 
 @njit_noalloc
-def control(code, t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
+def control(code, t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     """Evaluate controller ``code`` (a compile-time literal); unknown codes return status 99."""
     literally(code)
     if code == ftsmc.CODE:
-        return ftsmc.control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work)
+        return ftsmc.control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work)
     if code == fxtntsmc.CODE:
-        return fxtntsmc.control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work)
+        return fxtntsmc.control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work)
     if code == open_loop.CODE:
-        return open_loop.control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work)
+        return open_loop.control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work)
     return 99

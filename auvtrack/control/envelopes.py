@@ -171,7 +171,7 @@ def params(ep, off):
             ep[off + EP_THR])
 
 
-@njit
+@njit(inline="always")
 def axis_transform_given(kind, e, ed, rb, prm, r1):
     """:func:`axis_transform` with prm = :func:`params` and r1 = (rho1, rho1_dot, rho1_ddot) given.
 

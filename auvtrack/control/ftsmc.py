@@ -17,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit, njit_noalloc
-from ..plant.kinematics import attitude
 from .params import FTSMCParams
 from .registry import CompiledController
 from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
@@ -34,10 +33,9 @@ def reaching(e, ed, beta, gam, k1, k2):
     return s, -s2g / (beta * gam) - k1 * sign(s) - k2 * s
 
 
-@njit_noalloc  # allocates nothing: no reference counting of its 8 array arguments (_jit.py)
-def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
+@njit_noalloc(inline="always")  # one function with dispatch.control for LLVM (_jit.py)
+def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FTSMC law; returns status 0 (it has no failure modes of its own)."""
-    att = attitude(eta[3], eta[4])
     e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
     s0, a0 = reaching(e[0], ed[0], cp[0], cp[1], cp[2], cp[3])
     s1, a1 = reaching(e[1], ed[1], cp[0], cp[1], cp[2], cp[3])

@@ -30,7 +30,6 @@ import numpy as np
 from .._jit import njit, njit_noalloc
 from . import envelopes, rbf
 from .registry import CompiledController
-from ..plant.kinematics import attitude
 from .dispatch_layout import NX_PLANT, WORK_SIZE
 from .tracking import error_state_forces, input_for_accel_forces, sign
 
@@ -131,13 +130,12 @@ def switch(se, alpha, sigma):
     return switch_c(se, alpha, sigma, b1, b2)
 
 
-@njit_noalloc  # allocates nothing: no reference counting of its 8 array arguments (_jit.py)
-def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
+@njit_noalloc(inline="always")
+def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FXTNTSMC law; status 1 if an error leaves its envelope.
 
     ``work[0:m]`` holds the RBF basis and ``work[ACC:ACC + 3]`` the commanded e_ddot.
     """
-    att = attitude(eta[3], eta[4])
     e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
     kind, est, m = int(cp[ENV]), int(cp[EST]), int(cp[NEUR])
     if est != rbf.NONE:

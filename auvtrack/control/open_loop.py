@@ -18,7 +18,7 @@ CODE = 3
 
 
 @njit
-def control(t, eta, nu, X, refm, vp, cp, tau, dX, aux, work):
+def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled open-loop input."""
     for i in range(3):
         tau[i] = cp[i] + cp[3 + i] * math.sin(2.0 * math.pi * cp[6 + i] * t)

@@ -25,7 +25,7 @@ ESTIMATORS = {"none": NONE, "printed": PRINTED, "omega": OMEGA}
 N_INPUT = 6
 
 
-@njit_noalloc
+@njit_noalloc(inline="always")
 def basis(e, ed, cp, off, m, width, psi):
     """Gaussian basis psi(x) of eq. (12), x = [e, e_dot], written to psi[0:m].
 
@@ -41,7 +41,7 @@ def basis(e, ed, cp, off, m, width, psi):
         psi[j] = math.exp(-d2 * inv)
 
 
-@njit_noalloc
+@njit_noalloc(inline="always")
 def estimate_and_adapt(X, off, m, psi, S_i, gain, dX):
     """chi_hat_i = W^T psi (eq. 33) with W = X[off : off + m]; dX gets W_dot (eq. 34).
 

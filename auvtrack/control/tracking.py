@@ -38,7 +38,7 @@ def error_state(eta, att, nu, refm, vp):
     return e, ed, f
 
 
-@njit_noalloc
+@njit_noalloc(inline="always")
 def error_state_forces(eta, att, nu, refm, vp):
     """:func:`error_state` plus the nominal C nu + D nu + G of eq. (1) as a 5-tuple.
 

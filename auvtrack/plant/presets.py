@@ -13,6 +13,8 @@ array of :mod:`auvtrack.plant.params`.
 """
 from __future__ import annotations
 
+import copy
+import functools
 import tomllib
 from dataclasses import dataclass
 from importlib import resources
@@ -56,8 +58,20 @@ class VehiclePreset:
 
 def available() -> list[str]:
     """Names of the presets shipped with the package."""
+    return list(_names())
+
+
+# Package data does not change while a process runs: list and parse each file once (preparing
+# a scenario reads its preset twice; parsing was most of the Python-side preparation time).
+@functools.lru_cache(maxsize=1)
+def _names() -> tuple[str, ...]:
     root = resources.files("auvtrack") / "data" / "vehicles"
-    return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
+    return tuple(sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml")))
+
+
+@functools.lru_cache(maxsize=None)
+def _parsed(name: str) -> dict:
+    return tomllib.loads((resources.files("auvtrack") / "data" / "vehicles" / f"{name}.toml").read_text())
 
 
 def get_preset(name: str) -> VehiclePreset:
@@ -80,8 +94,7 @@ def get_preset(name: str) -> VehiclePreset:
     """
     if name not in available():
         raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available()}")
-    text = (resources.files("auvtrack") / "data" / "vehicles" / f"{name}.toml").read_text()
-    raw = tomllib.loads(text)
+    raw = copy.deepcopy(_parsed(name))  # callers own what they get
     vals = {k: raw[k]["value"] for k in _FIELDS}
     return VehiclePreset(
         name=raw["name"],

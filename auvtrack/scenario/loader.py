@@ -38,7 +38,8 @@ def read_toml(path: str | os.PathLike) -> dict[str, Any]:
     label = os.fspath(path)
     try:
         with open(path, "rb") as fh:
-            return tomllib.load(fh)
+            data = fh.read()
+        return copy.deepcopy(_parse_bytes(data))
     except FileNotFoundError:
         raise ScenarioError(f"{label}: file not found") from None
     except IsADirectoryError:
@@ -49,6 +50,13 @@ def read_toml(path: str | os.PathLike) -> dict[str, Any]:
         raise ScenarioError(f"{label}: not a UTF-8 text file") from None
     except OSError as exc:
         raise ScenarioError(f"{label}: cannot read file ({one_line(exc.strerror or str(exc))})") from None
+
+
+@functools.lru_cache(maxsize=64)
+def _parse_bytes(data: bytes) -> dict[str, Any]:
+    """Parsed TOML, cached by content: a sweep preparing thousands of samples from one file
+    parses it once, and an edited file is parsed again (its bytes differ)."""
+    return tomllib.loads(data.decode("utf-8"))
 
 
 def _read_source(source: Source) -> tuple[str, dict[str, Any]]:

@@ -81,7 +81,7 @@ def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_ro
     if fresh:
         eval_reference(ref_p, t, refm)
     if ctrl_every == 0:
-        status = control(code, t, eta, nu, X, refm, vp_nom, cp, tau, dX, aux, work)
+        status = control(code, t, eta, nu, att, X, refm, vp_nom, cp, tau, dX, aux, work)
         if status != 0:
             return status
         tau[0], tau[1], tau[2] = saturate((tau[0], tau[1], tau[2]), sf, SF_ACT)
@@ -204,7 +204,7 @@ def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise
         if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, hold
             eval_reference(ref_p, t, refm)
             eta, nu = measure(X, noise, k // ctrl_every)
-            status = control(code, t, eta, nu, X, refm, vp_nom, cp, tau1, k1, aux1, work)
+            status = control(code, t, eta, nu, attitude(eta[3], eta[4]), X, refm, vp_nom, cp, tau1, k1, aux1, work)
             if status == 0 and not _finite3(tau1):
                 status = STATUS_NONFINITE_INPUT
             if status != 0:
