@@ -49,22 +49,36 @@ def bench_single(kind: str, *, repeat: int = 7, duration: float = 20.0) -> dict:
     Reports the wall time (``us_per_step``) and the CPU time of the running thread
     (``cpu_us_per_step``), which is less disturbed by other processes on a shared machine.
     """
+    return bench_singles((kind,), repeat=repeat, duration=duration)[0]
+
+
+def bench_singles(kinds: tuple[str, ...], *, repeat: int = 7, duration: float = 20.0) -> list[dict]:
+    """:func:`bench_single` for several controllers, their repetitions interleaved.
+
+    Round-robin timing: on a shared machine whose speed drifts for seconds at a time, a slow
+    spell then lands on every controller alike instead of on one, so the ratios stay meaningful.
+    """
     from ..simulation.api import run_prepared
 
-    prep = _prepared(kind, duration)
-    run_prepared(prep)  # compile or load from cache
-    times, cpu = [], []
+    preps = {k: _prepared(k, duration) for k in kinds}
+    status = {k: run_prepared(p).status for k, p in preps.items()}  # compile or load from cache
+    wall: dict[str, list[float]] = {k: [] for k in kinds}
+    cpu: dict[str, list[float]] = {k: [] for k in kinds}
     for _ in range(repeat):
-        t0, c0 = time.perf_counter(), time.thread_time()
-        res = run_prepared(prep)
-        cpu.append(time.thread_time() - c0)
-        times.append(time.perf_counter() - t0)
-    steps = int(prep.si[0])
-    per = [1e6 * t / steps for t in times]
-    return {"controller": kind, "us_per_step": round(statistics.median(per), 4),
-            "min_us_per_step": round(min(per), 4),
-            "cpu_us_per_step": round(statistics.median(1e6 * t / steps for t in cpu), 4),
-            "steps": steps, "repeat": repeat, "status": res.status, "machine": machine()}
+        for k, prep in preps.items():
+            t0, c0 = time.perf_counter(), time.thread_time()
+            run_prepared(prep)
+            cpu[k].append(time.thread_time() - c0)
+            wall[k].append(time.perf_counter() - t0)
+    rows = []
+    for k, prep in preps.items():
+        steps = int(prep.si[0])
+        per = [1e6 * t / steps for t in wall[k]]
+        rows.append({"controller": k, "us_per_step": round(statistics.median(per), 4),
+                     "min_us_per_step": round(min(per), 4),
+                     "cpu_us_per_step": round(statistics.median(1e6 * t / steps for t in cpu[k]), 4),
+                     "steps": steps, "repeat": repeat, "status": status[k], "machine": machine()})
+    return rows
 
 
 def warmup() -> dict:
@@ -109,10 +123,8 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
 
     say = print if progress else (lambda *a, **k: None)
     mach = machine()  # load average before our own runs
-    single = []
-    for kind in ("open_loop", "ftsmc", "fxtntsmc"):
-        say(f"single run: {kind}")
-        single.append(bench_single(kind, repeat=repeat, duration=20.0))
+    say("single runs")
+    single = bench_singles(("open_loop", "ftsmc", "fxtntsmc"), repeat=3 * repeat, duration=20.0)
     say("breakdown")
     breakdown = bench_breakdown(repeat=repeat)
     say("batch")
@@ -128,4 +140,4 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     return doc
 
 
-__all__ = ["bench_single", "bench_all", "warmup", "machine", "paper_scenario_path"]
+__all__ = ["bench_single", "bench_singles", "bench_all", "warmup", "machine", "paper_scenario_path"]

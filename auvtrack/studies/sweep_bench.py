@@ -66,18 +66,18 @@ def bench_breakdown(*, repeat: int = 7, duration: float = 5.0) -> list[dict]:
     from ..simulation.batch import run_metrics
     from .bench import paper_scenario_path
 
-    rows = []
-    for label, ov in BREAKDOWN:
-        prep = prepare(load_scenario(paper_scenario_path(), {"sim.duration": duration, **ov}))
+    preps = [prepare(load_scenario(paper_scenario_path(), {"sim.duration": duration, **ov})) for _, ov in BREAKDOWN]
+    for prep in preps:
         run_metrics(prep)
-        cpu = []
-        for _ in range(repeat):
+    cpu: list[list[float]] = [[] for _ in preps]
+    for _ in range(repeat):  # interleaved, so that a slow spell of the machine hits every variant
+        for prep, c in zip(preps, cpu):
             c0 = time.thread_time()
             run_metrics(prep)
-            cpu.append(time.thread_time() - c0)
-        rows.append({"variant": label, "overrides": ov,
-                     "cpu_us_per_step": round(1e6 * statistics.median(cpu) / int(prep.si[0]), 3)})
-    return rows
+            c.append(time.thread_time() - c0)
+    return [{"variant": label, "overrides": ov,
+             "cpu_us_per_step": round(1e6 * statistics.median(c) / int(prep.si[0]), 3)}
+            for (label, ov), prep, c in zip(BREAKDOWN, preps, cpu)]
 
 
 def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RUN_SECONDS) -> list[dict]:
@@ -88,23 +88,25 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
     """
     from ..simulation.batch import default_workers, run_batch
 
-    rows = []
-    for kind in ("ftsmc", "fxtntsmc"):
+    kinds, backends = ("ftsmc", "fxtntsmc"), ("serial", "threads", "prange")
+    preps, prep_ms = {}, {}
+    for kind in kinds:
+        _preps(kind, 2, duration)  # first call pays imports and one-off caches
         t0 = time.perf_counter()
-        preps = _preps(kind, runs, duration)
-        prep_ms = 1e3 * (time.perf_counter() - t0) / runs
-        for backend in ("serial", "threads", "prange"):
-            run_batch(preps[:2], backend=backend)  # warm
-            rates = []
-            for _ in range(repeat):
-                t0 = time.perf_counter()
-                run_batch(preps, backend=backend)
-                rates.append(runs / (time.perf_counter() - t0))
-            rows.append({"controller": kind, "backend": backend, "runs": runs, "run_seconds": duration,
-                         "runs_per_s": round(statistics.median(rates), 2), "max_runs_per_s": round(max(rates), 2),
-                         "prepare_ms_per_run": round(prep_ms, 3), "cores": default_workers(), "repeat": repeat,
-                         "load_avg_1min": _load()})
-    return rows
+        preps[kind] = _preps(kind, runs, duration)
+        prep_ms[kind] = 1e3 * (time.perf_counter() - t0) / runs
+        for backend in backends:
+            run_batch(preps[kind][:2], backend=backend)  # warm
+    rates: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
+    for _ in range(repeat):  # interleaved: a slow spell of the machine hits every row alike
+        for (kind, backend), r in rates.items():
+            t0 = time.perf_counter()
+            run_batch(preps[kind], backend=backend)
+            r.append(runs / (time.perf_counter() - t0))
+    return [{"controller": kind, "backend": backend, "runs": runs, "run_seconds": duration,
+             "runs_per_s": round(statistics.median(r), 2), "max_runs_per_s": round(max(r), 2),
+             "prepare_ms_per_run": round(prep_ms[kind], 3), "cores": default_workers(), "repeat": repeat,
+             "load_avg_1min": _load()} for (kind, backend), r in rates.items()]
 
 
 def bench_sweep(*, repeat: int = 3, workers: tuple[int, ...] = (1, 2), duration: float = RUN_SECONDS,
@@ -163,7 +165,9 @@ def write_results(doc: dict, out: Path) -> None:
              f"Measured {doc['date']} with `auvtrack bench --all` on {m['cpu']}, {m['cores']} cores, "
              f"Python {m['python']}, Numba {m['numba']}; load average at the start {m['load_avg_1_5_15']} "
              "(a shared, noisy machine: medians of "
-             f"{doc['repeat']} repetitions; the CPU-time column is less sensitive to other processes).", ""]
+             f"{doc['repeat']} repetitions, {3 * doc['repeat']} for the single runs, taken round-robin over the "
+             "rows of each table so that a slow spell of the machine hits every row alike; the CPU-time column "
+             "is less sensitive to other processes).", ""]
     load = m.get("load_avg_1_5_15") or [0.0]
     if load[0] > 0.5 * (m.get("cores") or 1):
         lines += ["**The machine was not idle when the suite started** (1-minute load average above half the "
