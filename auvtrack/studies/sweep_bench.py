@@ -98,11 +98,15 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
         for backend in backends:
             run_batch(preps[kind][:2], backend=backend)  # warm
     rates: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
-    for _ in range(repeat):  # interleaved: a slow spell of the machine hits every row alike
-        for (kind, backend), r in rates.items():
-            t0 = time.perf_counter()
-            run_batch(preps[kind], backend=backend)
-            r.append(runs / (time.perf_counter() - t0))
+    # controllers interleaved (a slow spell of the machine hits both alike), back ends one after
+    # the other: after a prange call the OpenMP layer's threads keep spinning for a while and
+    # would steal the core from a serial or thread-pool run that followed at once
+    for backend in backends:
+        for _ in range(repeat):
+            for kind in kinds:
+                t0 = time.perf_counter()
+                run_batch(preps[kind], backend=backend)
+                rates[(kind, backend)].append(runs / (time.perf_counter() - t0))
     return [{"controller": kind, "backend": backend, "runs": runs, "run_seconds": duration,
              "runs_per_s": round(statistics.median(r), 2), "max_runs_per_s": round(max(r), 2),
              "prepare_ms_per_run": round(prep_ms[kind], 3), "cores": default_workers(), "repeat": repeat,
