@@ -27,7 +27,7 @@ from .layout import C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, KIND_PAPER, KIND_PULS
 COMPONENT_TYPES = (PaperDisturbance, Pulse, GaussMarkovCurrent)
 
 
-@njit_noalloc
+@njit_noalloc(inline="always")
 def eval_disturbance(rows, current, t, eta, nu, vp, out):
     """Write the total disturbance omega(t) (5,) into ``out``: N (surge, sway, heave), N m (q, r).
 

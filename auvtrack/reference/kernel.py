@@ -40,7 +40,7 @@ NCOEF = 6  # c0, c1, c2, c3, A, B per axis
 SEG = 1 + 3 * NCOEF
 
 
-@njit_noalloc
+@njit_noalloc(inline="always")
 def eval_reference(ref_p, t, out):
     """Evaluate a packed reference at time ``t``.
 

@@ -125,7 +125,7 @@ def _log_row(log, row, t, X, tau, refm, e, aux, naux, dX, vp_nom):
     log[row, 20 + naux], log[row, 21 + naux], log[row, 22 + naux] = chi
 
 
-@njit_noalloc
+@njit_noalloc(inline="always")
 def _state_cause(X, theta_lim, state_lim):
     """Failure cause of a state (precedence: non-finite, pitch, state limit), one pass."""
     nonfinite = over = False

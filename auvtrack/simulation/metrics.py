@@ -62,7 +62,7 @@ def metrics_init(acc):
         acc[OFF_SETTLE + i] = np.nan
 
 
-@njit_noalloc
+@njit_noalloc(inline="always")
 def metrics_update(acc, t, dt, e, tau, t0, t1):
     """Add one integration step (left-point values) to the accumulator; allocation-free.
 
