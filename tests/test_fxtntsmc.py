@@ -3,6 +3,8 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 import auvtrack
 from auvtrack.control.fxtntsmc import StartOutsideEnvelope, surface, switch
@@ -219,3 +221,12 @@ def test_ftsmc_sig_pair_matches_two_sig_calls():
         for x in (0.0, 1e-300, -1e-200, 1e-8, -0.3, 2.5, -1e3, 1e150):
             got, ref = sig_pair(x, gam), (sig(x, gam), sig(x, 2.0 - gam))
             np.testing.assert_allclose(got, ref, rtol=1e-12, atol=0)
+
+
+@given(st.floats(-1e3, 1e3), st.floats(0, 10), st.floats(0, 10), st.floats(0, 10))
+def test_reaching_law_is_eq32(S, k1, k2, k3):
+    from auvtrack.control.fxtntsmc import reaching_law
+    from auvtrack.control.tracking import sig, sign
+
+    want = -k1 * sign(S) - k2 * sig(S, 3.0) - k3 * S
+    assert reaching_law(S, k1, k2, k3) == pytest.approx(want, rel=1e-12, abs=1e-300)

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from auvtrack.plant.dynamics import generalized_forces, nu_dot
-from auvtrack.plant.kinematics import attitude, eta_dot, j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
+from auvtrack.plant.kinematics import attitude, body_from_ned, eta_dot, j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
 from auvtrack.plant.presets import get_preset, pack_vehicle
 
 angles = st.floats(-1.3, 1.3)
@@ -36,6 +36,11 @@ def test_j1_is_the_rotation_without_roll(th, ps):
     out = np.array(eta_dot(attitude(th, ps), tuple(nu)))
     np.testing.assert_allclose(out[:3], _rotation_zyx(ps, th) @ nu[:3], atol=1e-14)
     np.testing.assert_allclose(out[:3], _j1(th, ps) @ nu[:3], atol=1e-14)
+    # body_from_ned is its transpose: J1^T J1 v = v
+    back = np.array(body_from_ned(attitude(th, ps), tuple(out[:3])))
+    np.testing.assert_allclose(back, nu[:3], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(body_from_ned(attitude(th, ps), (1.0, -2.0, 0.5)),
+                               _rotation_zyx(ps, th).T @ np.array([1.0, -2.0, 0.5]), rtol=0, atol=1e-14)
 
 
 @settings(max_examples=60)

@@ -46,12 +46,12 @@ def test_start_puts_the_virtual_point_at_the_requested_error(start, e0):
     ell = sc.vehicle.l if sc.vehicle.l is not None else 1.0
     att = attitude(eta[3], eta[4])
     pd, vd, _ = build_reference(dict(sc.reference)).evaluate(0.0)
-    assert np.allclose(np.array(virtual_point(tuple(eta), att, ell)) - pd, e0, atol=1e-12)
+    np.testing.assert_allclose(np.array(virtual_point(tuple(eta), att, ell)) - pd, e0, rtol=0, atol=1e-12)
     assert sc.envelope.widen_start and sc.envelope.xi0 == st.xi0
     if start == "matched":  # e_dot(0) = J3 v1 + J4 - eta_d_dot = 0 with sway = heave = 0
         assert nu[1] == 0 and nu[2] == 0
         v1 = np.array([nu[0], nu[3], nu[4]])
-        assert np.allclose(np.array(j3(att, ell)) @ v1, vd, atol=1e-12)
+        np.testing.assert_allclose(np.array(j3(att, ell)) @ v1, vd, rtol=0, atol=1e-12)
     else:
         assert np.all(nu == 0) and eta[3] == 0 and eta[4] == 0
     with pytest.raises(ValueError):
@@ -89,10 +89,11 @@ def test_quick_fixed_time_end_to_end(quick_run):
             assert r["cause"] in ("pitch_limit", "envelope_violation", "nonfinite", "state_limit", "nonfinite_input")
             assert 0 < r["fail_time"] < st.duration
         if r["controller"] == "fxtntsmc":  # the start treatment is applied exactly when |e_i| > xi0 rho0_i
-            rho0 = np.array([5.0, 0.5, 0.2])
+            rho0 = np.array(initial_scenario("fxtntsmc", (0.0, 0.0, 0.0), st).envelope.rho0)
             need = np.abs(r["e0_vec"]) > st.xi0 * rho0
             assert r["widened"] == bool(need.any())
-            assert np.allclose(r["widening"], np.where(need, np.abs(r["e0_vec"]) / st.xi0 - rho0, 0.0))
+            np.testing.assert_allclose(r["widening"], np.where(need, np.abs(r["e0_vec"]) / st.xi0 - rho0, 0.0),
+                                       rtol=1e-12, atol=0)
     # small initial errors complete and settle to 1 cm for both controllers
     small = [r for r in runs if r["e0"] <= 0.1]
     assert small and all(r["status"] == "ok" and r["settle_1cm"] is not None for r in small)

@@ -23,7 +23,6 @@ from auvtrack.studies.sweep import chunk_path, read_results, run_sweep
 from auvtrack.studies.sweep_schema import StudyError, load_study
 from auvtrack.studies.sweep_worker import run_chunk
 
-distributed = pytest.importorskip("distributed")
 
 STUDY = """
 name = "t"

@@ -489,3 +489,13 @@ def test_nonsingular_surface_caveat():
     assert any("z_switch" in n for n in th.fixed_time_bounds(P4).notes)
     printed = th.fixed_time_bounds(P4.model_copy(update=dict(surface="printed")))
     assert not any("z_switch" in n for n in printed.notes)
+
+
+@given(st.floats(1e-6, 50.0), st.floats(0.05, 5.0), st.floats(0.1, 0.99), st.floats(0.05, 5.0), st.floats(1.01, 3.0))
+def test_theory_surface_is_the_compiled_printed_surface(z, a1, a2, a3, a4):
+    """The root-finding S_e of eq. (28) equals fxtntsmc.surface (printed) for z > 0."""
+    from auvtrack.control.fxtntsmc import surface
+
+    got = th._se(z, a1, a2, a3, a4)
+    assert got == pytest.approx(surface(z, a1, a2, a3, a4, True, 0.0, 0.0)[0], rel=1e-12, abs=0)
+    assert th._se(0.0, a1, a2, a3, a4) == 0.0

@@ -65,9 +65,10 @@ def test_budget_and_seed_are_respected(monkeypatch):
     c = tuning.tune("ftsmc", tuning.Budget(**{**TINY.__dict__, "seed": 1}), workers=2)
     assert c.gains != a.gains
     space = tuning.SPACES["ftsmc"]
-    for (lo, hi), name in zip(space.bounds, space.names):
-        assert lo * (1 - 1e-3) <= a.gains[name] <= hi * (1 + 1e-3)
-    # the defaults are the first candidate, so the tuned gains are never worse on training
+    for (lo, hi), name in zip(space.bounds, space.names):  # rounding to 4 digits moves a gain by <= 5e-4
+        assert lo * (1 - 5e-4) <= a.gains[name] <= hi * (1 + 5e-4)
+    # the defaults are the first candidate, so the optimiser's best is never worse on training; the
+    # reported objective is re-evaluated with the gains rounded to 4 digits, which may cost a little
     assert a.train_objective <= a.start_objective * (1 + 1e-3)
 
 

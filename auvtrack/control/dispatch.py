@@ -8,7 +8,7 @@ Every controller's compiled law has the signature
 t        time (s)
 eta, nu  measured state, 5-tuples (see :mod:`auvtrack.plant.kinematics`)
 att      attitude(eta[3], eta[4]) = (cos theta, sin theta, cos psi, sin psi) of the measured
-         state, computed once by the engine (the plant's right-hand side needs it too)
+         state, computed by the engine (in continuous mode the plant's right-hand side shares it)
 X        full state; the controller's internal state is X[NX_PLANT:] (read only)
 refm     (3, 3) rows eta_d, eta_d_dot, eta_d_ddot
 vp       packed *nominal* vehicle parameters (the controller never sees the true plant)
@@ -22,7 +22,7 @@ status   0 = ok, otherwise a code of :data:`CONTROLLER_STATUS`
 
 Numba cannot cache a loop that receives a function as an argument, so the engine calls this one
 module-level switch with a compile-time literal code (the switch folds away); registering a
-controller adds one branch here.  Arrays are passed whole and indexed: slicing in the hot
+controller adds one branch here and one in ``engine.run_kernel``.  Arrays are passed whole and indexed: slicing in the hot
 path creates reference-counted views that cost more than the arithmetic.
 """
 from __future__ import annotations

@@ -86,7 +86,7 @@ def baseline(t, rho0, rho_inf, T, printed):
 
 @njit
 def risk_indicator(h, eps):
-    """Smooth indicator gamma(hbar) of eq. (22) and its derivative d gamma / d hbar."""
+    """Smooth indicator gamma(hbar) of eq. (22) and its derivative d gamma / d hbar (hbar and eps in 1/s)."""
     if h <= 0.0:
         return 1.0, 0.0
     if h >= 2.0 * eps:
@@ -109,7 +109,7 @@ def reactive_trigger(a, thr):
 
 @njit
 def solve_risk_loop(h0, k, eps):
-    """Solve g = gamma(h0 + k g) on [0, 1] (loop 1 of ERRATA 10); k >= 0; returns g."""
+    """Solve g = gamma(h0 + k g) of eq. (21)-(22) on [0, 1] (loop 1 of ERRATA 10); h0, k in 1/s, k >= 0; returns g."""
     lo, hi = 0.0, 1.0
     g, _ = risk_indicator(h0, eps)
     for _ in range(60):

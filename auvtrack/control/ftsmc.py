@@ -27,13 +27,13 @@ AUX_NAMES = ("s_x", "s_y", "s_z")
 
 @njit
 def reaching(e, ed, beta, gam, k1, k2):
-    """Sliding variable s and commanded e_ddot of one axis."""
+    """Sliding variable s (m) and commanded e_ddot (m/s^2) of one axis (Feng, Yu & Man 2002; ERRATA 16)."""
     sg, s2g = sig_pair(ed, gam)  # sig^gamma(e_dot), sig^(2-gamma)(e_dot)
     s = e + beta * sg
     return s, -s2g / (beta * gam) - k1 * sign(s) - k2 * s
 
 
-@njit_noalloc(inline="always")  # one function with dispatch.control for LLVM (_jit.py)
+@njit_noalloc(inline="always")  # one function with dispatch.control for LLVM (docs/architecture.md)
 def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FTSMC law; returns status 0 (it has no failure modes of its own)."""
     e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)

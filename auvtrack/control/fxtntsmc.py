@@ -69,7 +69,7 @@ def surface_coeffs(a2, zs):
 
 @njit
 def switch_coeffs(alpha, sigma):
-    """beta1, beta2 of eq. (27): C1 at |S_e| = sigma; constant per run (packed in ``cp``)."""
+    """beta1, beta2 of eq. (27): C1 at |S_e| = sigma (S_e dimensionless); constant per run (packed in ``cp``)."""
     return (2.0 - alpha) * sigma ** (alpha - 1.0), (alpha - 1.0) * sigma ** (alpha - 2.0)
 
 
@@ -130,9 +130,15 @@ def switch(se, alpha, sigma):
     return switch_c(se, alpha, sigma, b1, b2)
 
 
+@njit
+def reaching_law(S, k1, k2, k3):
+    """nu = -kappa1 sign(S) - kappa2 sig^3(S) - kappa3 S of eq. (32), the desired S_dot (S in m/s, nu in m/s^2)."""
+    return -k1 * sign(S) - k2 * S * S * S - k3 * S
+
+
 @njit_noalloc(inline="always")
 def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
-    """Compiled FXTNTSMC law; status 1 if an error leaves its envelope.
+    """Compiled FXTNTSMC law, eq. (26)-(34) corrected (tau in N, N m); status 1 if an error leaves its envelope.
 
     ``work[0:m]`` holds the RBF basis and ``work[ACC:ACC + 3]`` the commanded e_ddot.
     """
@@ -155,7 +161,7 @@ def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
         se, dse = surface_c(z, cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2])
         s1, dphi = switch_c(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2])
         S = zd + s1
-        reach = -cp[K1] * sign(S) - cp[K2] * S * S * S - cp[K3] * S
+        reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
         edd = (reach - dphi * dse * zd - Omd * ed[i] + c0 + U * ed[i]) / (Om - c1)
         chat = 0.0
         if est != rbf.NONE:

@@ -43,7 +43,7 @@ def basis(e, ed, cp, off, m, width, psi):
 
 @njit_noalloc(inline="always")
 def estimate_and_adapt(X, off, m, psi, S_i, gain, dX):
-    """chi_hat_i = W^T psi (eq. 33) with W = X[off : off + m]; dX gets W_dot (eq. 34).
+    """chi_hat_i = W^T psi (eq. 33, m/s^2) with W = X[off : off + m]; dX gets W_dot (eq. 34).
 
     W_dot = gain psi S_i - W (W^T W), gain = 1 (printed law) or Omega_i (Omega-weighted law).
     """

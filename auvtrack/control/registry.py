@@ -8,8 +8,9 @@ A controller is one module that defines
 * a ``setup(scenario, ctx)`` function returning a :class:`CompiledController`,
 
 and registers itself here with a unique integer ``code``.  Adding a controller means one new
-file, one ``register`` call (in :mod:`auvtrack.control`) and one branch in
-:mod:`auvtrack.control.dispatch` (compiled code cannot look functions up at run time).
+file, one ``register`` call (in :mod:`auvtrack.control`), one branch in
+:mod:`auvtrack.control.dispatch` and one in :func:`auvtrack.simulation.engine.run_kernel`
+(compiled code cannot look functions up at run time), plus its parameter model.
 """
 from __future__ import annotations
 

@@ -35,6 +35,8 @@ from typing import Any
 
 from scipy.optimize import brentq
 
+from .fxtntsmc import switch_coeffs
+
 __all__ = [
     "FixedTimeBounds",
     "TheoremConditionError",
@@ -283,7 +285,7 @@ def t22_bound(a1: float, a2: float, a3: float, a4: float, alpha: float, sigma: f
     """
     if not (a1 > 0 and a3 > 0 and g2 > 0 and sigma > 0 and a2 < 1 < a4):
         return INF
-    beta = (2.0 - alpha) * sigma ** (alpha - 1.0) if printed else switch_slope(alpha, sigma)
+    beta = switch_coeffs.py_func(alpha, sigma)[0] if printed else switch_slope(alpha, sigma)
     if not beta > 0:
         return INF
     return (1.0 / (g2 * beta)) * (1.0 / (a1 * (1.0 - a2)) + 1.0 / (a3 * (a4 - 1.0)))
@@ -328,6 +330,11 @@ def _choose_lams(kappa2: float, lam1: float | None, lam2: float | None) -> tuple
 # --------------------------------------------------------------------------- the bounds
 
 def _se(z: float, a1: float, a2: float, a3: float, a4: float) -> float:
+    """S_e(z) of eq. (28) as printed, for z >= 0 (z dimensionless), for root finding.
+
+    Scalar Python form of :func:`auvtrack.control.fxtntsmc.surface` with ``printed`` (pinned to
+    it in ``tests/test_theory.py``), which is NaN at z = 0 (it forms z^(a2-1)); this one is 0 there.
+    """
     return a1 * z**a2 + a3 * z**a4
 
 
@@ -598,8 +605,7 @@ def fixed_time_bounds(
         p = math.sqrt(2.0 * Lam)  # |S_i|^2 / 2 <= V
 
     # --- phase 2: (45)-(54)
-    beta1 = (2.0 - al) * sg ** (al - 1.0) if sg > 0 else math.nan
-    beta2 = (al - 1.0) * sg ** (al - 2.0) if sg > 0 else math.nan
+    beta1, beta2 = switch_coeffs.py_func(al, sg) if sg > 0 else (math.nan, math.nan)
     beta_eff = switch_slope(al, sg) if sg > 0 else math.nan
     T21 = t21_bound(a1, a2, a3, a4, al, g1)
     T22 = t22_bound(a1, a2, a3, a4, al, sg, g2)

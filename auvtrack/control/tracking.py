@@ -30,7 +30,7 @@ def mat_vec(A, x):
 
 @njit_noalloc
 def error_state(eta, att, nu, refm, vp):
-    """Return (e, e_dot, f) as 3-tuples for the nominal model ``vp`` (eq. 14-15).
+    """Return (e (m), e_dot (m/s), f (m/s^2)) as 3-tuples for the nominal model ``vp`` (eq. 14-15).
 
     ``refm`` rows are eta_d, eta_d_dot, eta_d_ddot; f is the input-free part of e_ddot.
     """
@@ -65,7 +65,7 @@ def error_state_forces(eta, att, nu, refm, vp):
 
 @njit_noalloc
 def input_for_accel(att, nu, vp, f, acc):
-    """Nominal input tau_bar = (tau_u, tau_q, tau_r) giving e_ddot = acc (ERRATA 13 route).
+    """Nominal input tau_bar = (tau_u (N), tau_q, tau_r (N m)) giving e_ddot = acc (m/s^2): eq. (30)-(32) via ERRATA 13.
 
     v1_dot = J3^-1 (acc - f);  tau_bar = M_bar v1_dot + C_bar v1 + D_bar v1 + G_bar.
     """
@@ -81,7 +81,7 @@ def input_for_accel_forces(att, vp, f, acc, g):
 
 @njit
 def lumped_disturbance(att, nu_dot_true, nu_dot_nom, ell):
-    """True lumped disturbance chi (m/s^2): e_ddot(true plant) - e_ddot(nominal model), same input.
+    """True lumped disturbance chi of eq. (15) (m/s^2): e_ddot(true plant) - e_ddot(nominal model), same input.
 
     chi = J3 (v1_dot_true - v1_dot_nom) + the J4_dot terms of the sway/heave acceleration
     differences, i.e. everything eq. (15) with the nominal model does not predict (ERRATA 4).

@@ -39,6 +39,7 @@ import numpy as np
 from scipy.signal import lfilter
 
 from .._jit import njit_noalloc
+from ..plant.kinematics import attitude, body_from_ned
 from ..plant.params import D0
 from . import _validate as val
 from .layout import C_DT, C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, ROW_SIZE
@@ -150,12 +151,11 @@ def current_velocity(rows, r, current, t):
 
 @njit_noalloc
 def add_current_force(vx, vy, vz, eta, vp, out):
-    """Add omega[0:3] = diag(d11, d22, d33) J1(theta, psi)^T V_c (N) to ``out`` (5,)."""
-    ct, st = math.cos(eta[3]), math.sin(eta[3])
-    cp, sp = math.cos(eta[4]), math.sin(eta[4])
-    uc = ct * cp * vx + ct * sp * vy - st * vz
-    vc = -sp * vx + cp * vy
-    wc = st * cp * vx + st * sp * vy + ct * vz
+    """Add omega[0:3] = diag(d11, d22, d33) J1(theta, psi)^T V_c (N) to ``out`` (5,).
+
+    V_c = (vx, vy, vz) is the NED current (m/s); J1^T is :func:`~auvtrack.plant.kinematics.body_from_ned`.
+    """
+    uc, vc, wc = body_from_ned(attitude(eta[3], eta[4]), (vx, vy, vz))
     out[0] += vp[D0] * uc
     out[1] += vp[D0 + 1] * vc
     out[2] += vp[D0 + 2] * wc

@@ -32,7 +32,7 @@ def generalized_forces(att, nu, vp):
 
 @njit_noalloc
 def nu_dot(att, nu, tau3, omega, vp):
-    """Kinetics eq. (1): d/dt nu (5-tuple) for input tau3 = (tau_u, tau_q, tau_r)."""
+    """Kinetics eq. (1): d/dt nu (5-tuple; m/s^2 ×3, rad/s^2 ×2) for input tau3 = (tau_u (N), tau_q, tau_r (N m))."""
     g = generalized_forces(att, nu, vp)
     return ((tau3[0] + omega[0] - g[0]) / vp[M0],
             (omega[1] - g[1]) / vp[M0 + 1],

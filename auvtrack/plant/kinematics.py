@@ -39,7 +39,7 @@ def attitude(theta, psi):
 
 @njit
 def eta_dot(att, nu):
-    """Kinematics eq. (1) with the corrected J1 (ERRATA 1): d/dt eta as a 5-tuple."""
+    """Kinematics eq. (1) with the corrected J1 (ERRATA 1): d/dt eta as a 5-tuple (m/s ×3, rad/s ×2)."""
     ct, st, cp, sp = att
     u, v, w, q, r = nu[0], nu[1], nu[2], nu[3], nu[4]
     return (ct * cp * u - sp * v + st * cp * w,
@@ -47,6 +47,15 @@ def eta_dot(att, nu):
             -st * u + ct * w,
             q,
             r / ct)
+
+
+@njit
+def body_from_ned(att, v):
+    """J1(theta, psi)^T v: a NED vector v (e.g. a current, m/s) in body axes (J1 of eq. 1, ERRATA 1)."""
+    ct, st, cp, sp = att
+    return (ct * cp * v[0] + ct * sp * v[1] - st * v[2],
+            -sp * v[0] + cp * v[1],
+            st * cp * v[0] + st * sp * v[1] + ct * v[2])
 
 
 @njit
@@ -58,7 +67,7 @@ def virtual_point(eta, att, ell):
 
 @njit
 def j3(att, ell):
-    """Input matrix J3 of eq. (3), corrected (ERRATA 2), as a tuple of rows."""
+    """Input matrix J3 of eq. (3), corrected (ERRATA 2), as a tuple of rows: J3 v1 in m/s for v1 = (u, q, r)."""
     ct, st, cp, sp = att
     return ((ct * cp, -ell * st * cp, -ell * sp),
             (ct * sp, -ell * st * sp, ell * cp),
@@ -67,7 +76,7 @@ def j3(att, ell):
 
 @njit
 def j3_inv(att, ell):
-    """Closed-form inverse of J3 (det J3 = ell**2), as a tuple of rows."""
+    """Closed-form inverse of J3 of eq. (3) (det J3 = ell**2), as a tuple of rows (maps m/s to (m/s, rad/s, rad/s))."""
     ct, st, cp, sp = att
     return ((ct * cp, ct * sp, -st),
             (-st * cp / ell, -st * sp / ell, -ct / ell),
@@ -83,7 +92,7 @@ def j4(att, v, w):
 
 @njit
 def j3_dot(att, theta_dot, psi_dot, ell):
-    """Time derivative of J3 along (theta_dot, psi_dot), as a tuple of rows."""
+    """Time derivative of J3 of eq. (3) along (theta_dot, psi_dot) (rad/s), as a tuple of rows (eq. 15)."""
     ct, st, cp, sp = att
     td, pd = theta_dot, psi_dot
     return ((-st * cp * td - ct * sp * pd, -ell * (ct * cp * td - st * sp * pd), -ell * cp * pd),
@@ -93,7 +102,7 @@ def j3_dot(att, theta_dot, psi_dot, ell):
 
 @njit
 def j4_dot(att, v, w, theta_dot, psi_dot, v_dot, w_dot):
-    """Time derivative of J4 (needs the sway/heave accelerations, ERRATA 4), as a 3-tuple."""
+    """Time derivative of J4 of eq. (3) (m/s^2; needs the sway/heave accelerations, ERRATA 4), as a 3-tuple (eq. 15)."""
     ct, st, cp, sp = att
     td, pd = theta_dot, psi_dot
     return (-v_dot * sp - v * cp * pd + w_dot * st * cp + w * (ct * cp * td - st * sp * pd),

@@ -380,7 +380,7 @@ class Scenario(BaseModel):
         Run name (folder ``runs/<name>``) and free text.
     seed : int
         Seed of every random stream.
-    sim, vehicle, uncertainty, initial, envelope, estimator, metrics, output : section models
+    sim, vehicle, uncertainty, initial, envelope, estimator, metrics, output, actuator, sensor : section models
         The TOML sections of the same names.
     reference : dict
         Resolved reference spec (``kind`` and every field of that kind).

@@ -289,6 +289,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     analysis = {s0: _analysis([r for r in rows if r["start"] == s0], st) for s0 in st.starts}
     mags = sorted(st.magnitudes)
     fx = [r for r in rows if r["controller"].startswith("fxtntsmc")]
+    env = sc.envelope
 
     rep = Report(out, "Fixed-time convergence: settling time against the initial error")
     rep.paragraph(
@@ -310,10 +311,11 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
                      "0.41 m/s (a velocity/heading error on top of e(0))"}[s0] for s0 in st.starts)
         + ".  In both the virtual point (offset l = 1 m) is placed at eta_d(0) + e(0).",
         "Start treatment (ERRATA 9): `envelope.widen_start = true`, `envelope.xi0 = "
-        f"{st.xi0:g}`: on every axis with |e_i(0)| > xi0 rho1_i(0) (rho1(0) = rho0 = 5, 0.5, 0.2 m) the envelope "
-        "adjustment starts at rho_bar_i(0) = |e_i(0)|/xi0 - rho1_i(0) and decays at rate lambda1 = 0.5 /s "
-        f"(eq. 25). It was applied in {sum(r['widened'] for r in fx)} of {len(fx)} FXTNTSMC runs (every run whose "
-        "error exceeds 0.9 rho0 on an axis); largest widening "
+        f"{st.xi0:g}`: on every axis with |e_i(0)| > xi0 rho1_i(0) (rho1(0) = rho0 = "
+        f"{', '.join(f'{x:g}' for x in env.rho0)} m) the envelope adjustment starts at rho_bar_i(0) = "
+        f"|e_i(0)|/xi0 - rho1_i(0) and decays at rate lambda1 = {env.lambda1:g} /s (eq. 25). It was applied in "
+        f"{sum(r['widened'] for r in fx)} of {len(fx)} FXTNTSMC runs (every run whose error exceeds "
+        f"{st.xi0:g} rho0 on an axis); largest widening "
         + fmt(max((max(r['widening']) for r in fx if r['widening']), default=0.0)) + " m (per-run values in the "
         "table below).  The FTSMC has no envelope and needs no treatment.",
         "Settling time 0 means the error never exceeded the threshold (drawn at 0.05 s on the log axes); a run "
