@@ -3,7 +3,8 @@
 Numba's on-disk cache is keyed by the timestamp of the file that defines a function, not by the
 files it calls, so editing ``plant/dynamics.py`` would leave a stale cached ``simulation/engine.py``
 kernel.  We therefore place the cache in a directory named by a hash of *all* package sources:
-any source change selects a fresh directory.  Set ``AUVTRACK_CACHE_DIR`` to override the root.
+any source change selects a fresh directory.  The name also carries the vector-math back end of
+:mod:`auvtrack._vecmath` (compiled code differs between them).  Set ``AUVTRACK_CACHE_DIR`` to override the root.
 """
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ import os
 from pathlib import Path
 
 import numba
+
+from . import _vecmath
 
 _PKG = Path(__file__).resolve().parent
 
@@ -28,7 +31,7 @@ def source_hash() -> str:
 def cache_dir() -> Path:
     """Return the numba cache directory for the current package sources."""
     root = Path(os.environ.get("AUVTRACK_CACHE_DIR", Path.home() / ".cache" / "auvtrack"))
-    return root / f"numba-{numba.__version__}-{source_hash()[:16]}"
+    return root / f"numba-{numba.__version__}-{source_hash()[:16]}-{_vecmath.BACKEND}"
 
 
 numba.config.CACHE_DIR = str(cache_dir())

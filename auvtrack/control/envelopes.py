@@ -176,7 +176,19 @@ def axis_transform_given(kind, e, ed, rb, prm, r1):
     """:func:`axis_transform` with prm = :func:`params` and r1 = (rho1, rho1_dot, rho1_ddot) given.
 
     The compiled law evaluates exp(-t / (T - t)) once for the three axes
-    (:func:`baseline_shape`) and passes each axis' :func:`baseline_from_shape`.  Scalars and
+    (:func:`baseline_shape`) and passes each axis' :func:`baseline_from_shape`.
+    """
+    status, tr = axis_transform_xi(kind, e, ed, rb, prm, r1)
+    if status != 0 or kind == NONE:
+        return status, tr
+    return status, (math.atanh(tr[0]),) + tr[1:]  # z = 0.5 ln((1 + xi) / (1 - xi)), eq. (17)
+
+
+@njit(inline="always")
+def axis_transform_xi(kind, e, ed, rb, prm, r1):
+    """:func:`axis_transform_given` with xi = e / rho in the place of z = atanh(xi) (e itself for kind "none").
+
+    For the compiled law, which takes atanh of the three axes in one vector call.  Scalars and
     tuples only (no arrays: an array argument costs two atomic reference-count updates per call).
     Divisions by rho, D = rho^2 - e^2, lambda3 and den are multiplications by their reciprocals.
     """
@@ -231,9 +243,8 @@ def axis_transform_given(kind, e, ed, rb, prm, r1):
     Om = rho * iD
     U = rhod * iD
     Dd = 2.0 * rho * rhod - 2.0 * e * ed
-    z = math.atanh(xi)  # = 0.5 ln((1 + xi) / (1 - xi)), eq. (17)
     Omd = U - Om * Dd * iD  # rho_dot / D - rho Dd / D^2
     # U_dot = rho_ddot / D - rho_dot Dd / D^2, rho_ddot = p + q e_ddot
     c0 = (p - U * Dd) * iD * e
     c1 = q * iD * e
-    return 0, (z, Om * ed - U * e, Om, U, Omd, c0, c1, rho, rbd, rho1, g)
+    return 0, (xi, Om * ed - U * e, Om, U, Omd, c0, c1, rho, rbd, rho1, g)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import njit, njit_noalloc
+from .._vecmath import atanh4, pow4
 from . import envelopes, rbf
 from .registry import CompiledController
 from .dispatch_layout import NX_PLANT, WORK_SIZE
@@ -74,29 +75,76 @@ def switch_coeffs(alpha, sigma):
 
 
 @njit
+def power_below(x, p):
+    """x^(p-1), exactly x when p = 2 (x >= 0; x > 0 when p < 1)."""
+    return x if p == 2.0 else x ** (p - 1.0)
+
+
+@njit
 def pow_and_power_below(x, p):
     """(x^p, x^(p-1)) with one pow: x^p = x x^(p-1), and x^(p-1) = x when p = 2.
 
     x >= 0, and x > 0 when p < 1 (x^(p-1) is infinite at 0; callers stay away from 0 there).
     """
-    q = x if p == 2.0 else x ** (p - 1.0)
+    q = power_below(x, p)
     return x * q, q
+
+
+@njit_noalloc(inline="always")
+def powers_below3(x, p, need):
+    """:func:`power_below` of the bases ``x`` (3-tuple) where ``need`` (3 booleans) says so, else 1.
+
+    Two or three needed powers take one vector call (:func:`auvtrack._vecmath.pow4`, within
+    4 ulp of :func:`power_below`), a single one a scalar call; exactly the bases when p = 2.
+    """
+    if p == 2.0:
+        return x
+    n = int(need[0]) + int(need[1]) + int(need[2])
+    if n >= 2:
+        q = p - 1.0
+        r = pow4((x[0], x[1], x[2], 1.0), (q, q, q, q))
+        return r[0], r[1], r[2]
+    q0 = power_below(x[0], p) if need[0] else 1.0
+    q1 = power_below(x[1], p) if need[1] else 1.0
+    q2 = power_below(x[2], p) if need[2] else 1.0
+    return q0, q1, q2
+
+
+SURF_QUADRATIC, SURF_POWER, SURF_FLOORED = 0, 1, 2
+
+
+@njit
+def surface_branch(az, printed, zs, zfloor):
+    """Which form of sig^a2(z) eq. (28) uses at |z| = az: quadratic, power, or floored (printed only)."""
+    if not printed and az <= zs:
+        return SURF_QUADRATIC
+    return SURF_POWER if az >= zfloor else SURF_FLOORED
+
+
+@njit
+def surface_q(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2, qa):
+    """:func:`surface` given the quadratic's (c1, c2) = surface_coeffs(a2, zs) and qa = power_below(|z|, a2).
+
+    qa is used only on the power branch (:func:`surface_branch`), so a caller may pass any value
+    elsewhere.
+    """
+    az = abs(z)
+    s = sign(z)
+    branch = surface_branch(az, printed, zs, zfloor)
+    if branch == SURF_QUADRATIC:
+        g, dg = c1 * z + c2 * s * z * z, c1 + 2.0 * c2 * az
+    elif branch == SURF_POWER:
+        g, dg = s * (az * qa), a2 * qa
+    else:
+        g, dg = s * az**a2, a2 * zfloor ** (a2 - 1.0)
+    pb, qb = pow_and_power_below(az, a4)
+    return a1 * g + a3 * s * pb, a1 * dg + a3 * a4 * qb
 
 
 @njit
 def surface_c(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2):
     """:func:`surface` with the quadratic's coefficients (c1, c2) = surface_coeffs(a2, zs) given."""
-    az = abs(z)
-    s = sign(z)
-    if not printed and az <= zs:
-        g, dg = c1 * z + c2 * s * z * z, c1 + 2.0 * c2 * az
-    elif az >= zfloor:
-        pa, qa = pow_and_power_below(az, a2)
-        g, dg = s * pa, a2 * qa
-    else:
-        g, dg = s * az**a2, a2 * zfloor ** (a2 - 1.0)
-    pb, qb = pow_and_power_below(az, a4)
-    return a1 * g + a3 * s * pb, a1 * dg + a3 * a4 * qb
+    return surface_q(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2, power_below(abs(z), a2))
 
 
 @njit
@@ -111,13 +159,21 @@ def surface(z, a1, a2, a3, a4, printed, zs, zfloor):
 
 
 @njit
-def switch_c(se, alpha, sigma, b1, b2):
-    """:func:`switch` with (beta1, beta2) = switch_coeffs(alpha, sigma) given."""
+def switch_q(se, alpha, sigma, b1, b2, qs):
+    """:func:`switch` given (beta1, beta2) = switch_coeffs(alpha, sigma) and qs = power_below(|S_e|, alpha).
+
+    qs is used only where |S_e| > sigma.
+    """
     a = abs(se)
     if a > sigma:
-        pa, qa = pow_and_power_below(a, alpha)
-        return sign(se) * pa, alpha * qa
+        return sign(se) * (a * qs), alpha * qs
     return b1 * se + b2 * sign(se) * se * se, b1 + 2.0 * b2 * a
+
+
+@njit
+def switch_c(se, alpha, sigma, b1, b2):
+    """:func:`switch` with (beta1, beta2) = switch_coeffs(alpha, sigma) given."""
+    return switch_q(se, alpha, sigma, b1, b2, power_below(abs(se), alpha))
 
 
 @njit
@@ -137,6 +193,34 @@ def reaching_law(S, k1, k2, k3):
 
 
 @njit_noalloc(inline="always")
+def _transform(kind, shape, cp, eprm, e, ed, X, i):
+    """Envelope and error transformation of axis ``i`` (eq. 17-25) with xi for z, :func:`envelopes.axis_transform_xi`."""
+    r1 = envelopes.axis_baseline(shape, cp, EP0, i)
+    return envelopes.axis_transform_xi(kind, e[i], ed[i], X[XC + i], eprm, r1)
+
+
+@njit_noalloc(inline="always")
+def _finish_axis(i, tr, z, se, dse, qs, ed_i, X, cp, est, m, work, dX, aux):
+    """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27), the commanded e_ddot (eq. 32-34, ERRATA 13), estimate, logs.
+
+    Writes ``work[ACC + i]`` (commanded e_ddot minus the estimate), dX of rho_bar_i and of
+    W_i, and the aux channels; ``qs`` = power_below(|S_e|, alpha).
+    """
+    _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
+    s1, dphi = switch_q(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2], qs)
+    S = zd + s1
+    reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
+    edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / (Om - c1)
+    chat = 0.0
+    if est != rbf.NONE:
+        gain = Om if est == rbf.OMEGA else 1.0
+        chat = rbf.estimate_and_adapt(X, XC + 3 + i * m, m, work, S, gain, dX)
+    work[ACC + i] = edd - chat
+    dX[XC + i] = rbd
+    aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, chat, S, g, z
+
+
+@njit_noalloc(inline="always")
 def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FXTNTSMC law, eq. (26)-(34) corrected (tau in N, N m); status 1 if an error leaves its envelope.
 
@@ -152,24 +236,33 @@ def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     if kind != envelopes.NONE:
         shape = envelopes.baseline_shape(t, cp[EP0 + envelopes.EP_T])
     eprm = envelopes.params(cp, EP0)
-    for i in range(3):
-        r1 = envelopes.axis_baseline(shape, cp, EP0, i)
-        status, tr = envelopes.axis_transform_given(kind, e[i], ed[i], X[XC + i], eprm, r1)
-        if status != 0:
-            return status
-        z, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
-        se, dse = surface_c(z, cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2])
-        s1, dphi = switch_c(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2])
-        S = zd + s1
-        reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
-        edd = (reach - dphi * dse * zd - Omd * ed[i] + c0 + U * ed[i]) / (Om - c1)
-        chat = 0.0
-        if est != rbf.NONE:
-            gain = Om if est == rbf.OMEGA else 1.0
-            chat = rbf.estimate_and_adapt(X, XC + 3 + i * m, m, work, S, gain, dX)
-        work[ACC + i] = edd - chat
-        dX[XC + i] = rbd
-        aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, chat, S, g, z
+    # three phases over the axes, so that atanh (eq. 17) and each power of eq. (27)-(28) is one vector call
+    st0, tr0 = _transform(kind, shape, cp, eprm, e, ed, X, 0)
+    if st0 != 0:
+        return st0
+    st1, tr1 = _transform(kind, shape, cp, eprm, e, ed, X, 1)
+    if st1 != 0:
+        return st1
+    st2, tr2 = _transform(kind, shape, cp, eprm, e, ed, X, 2)
+    if st2 != 0:
+        return st2
+    z = (tr0[0], tr1[0], tr2[0])  # xi = e / rho, or e without an envelope
+    if kind != envelopes.NONE:
+        zv = atanh4((z[0], z[1], z[2], 0.0))  # z = atanh(xi), eq. (17)
+        z = (zv[0], zv[1], zv[2])
+    az = (abs(z[0]), abs(z[1]), abs(z[2]))
+    need = (surface_branch(az[0], printed, cp[ZSW], cp[ZFL]) == SURF_POWER,
+            surface_branch(az[1], printed, cp[ZSW], cp[ZFL]) == SURF_POWER,
+            surface_branch(az[2], printed, cp[ZSW], cp[ZFL]) == SURF_POWER)
+    qz = powers_below3(az, cp[A2], need)
+    se0, dse0 = surface_q(z[0], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[0])
+    se1, dse1 = surface_q(z[1], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[1])
+    se2, dse2 = surface_q(z[2], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[2])
+    ase = (abs(se0), abs(se1), abs(se2))
+    qs = powers_below3(ase, cp[ALPHA], (ase[0] > cp[SIGMA], ase[1] > cp[SIGMA], ase[2] > cp[SIGMA]))
+    _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], X, cp, est, m, work, dX, aux)
+    _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], X, cp, est, m, work, dX, aux)
+    _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], X, cp, est, m, work, dX, aux)
     acc = (work[ACC], work[ACC + 1], work[ACC + 2])
     tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, acc, gf)
     return 0

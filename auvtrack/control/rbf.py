@@ -13,11 +13,10 @@ seed (stream "rbf") as in Section 4: centres uniform in [-1, 1], weights uniform
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .._jit import njit_noalloc
+from .._vecmath import exp8
 from .._seeding import rng
 
 NONE, PRINTED, OMEGA = 0, 1, 2
@@ -26,19 +25,34 @@ N_INPUT = 6
 
 
 @njit_noalloc(inline="always")
+def _exponent(e, ed, cp, off, j, m, inv):
+    """-||x - c_j||^2 / (2 b^2) of neuron j (eq. 12), 0 for a padding lane j >= m."""
+    if j >= m:
+        return 0.0
+    d2 = 0.0
+    for k in range(3):
+        a = e[k] - cp[off + j * N_INPUT + k]
+        b = ed[k] - cp[off + j * N_INPUT + 3 + k]
+        d2 += a * a + b * b
+    return -d2 * inv
+
+
+@njit_noalloc(inline="always")
 def basis(e, ed, cp, off, m, width, psi):
     """Gaussian basis psi(x) of eq. (12), x = [e, e_dot], written to psi[0:m].
 
-    The centres are ``cp[off : off + 6 m]``, row j = (c_e (3), c_e_dot (3)).
+    psi_j = exp(-||x - c_j||^2 / (2 b^2)), b = ``width``, eight neurons per vector exp
+    (:func:`auvtrack._vecmath.exp8`, within 4 ulp of libm's exp).  The centres are
+    ``cp[off : off + 6 m]``, row j = (c_e (3), c_e_dot (3)).
     """
     inv = 1.0 / (2.0 * width * width)
-    for j in range(m):
-        d2 = 0.0
-        for k in range(3):
-            a = e[k] - cp[off + j * N_INPUT + k]
-            b = ed[k] - cp[off + j * N_INPUT + 3 + k]
-            d2 += a * a + b * b
-        psi[j] = math.exp(-d2 * inv)
+    for j0 in range(0, m, 8):
+        r = exp8((_exponent(e, ed, cp, off, j0, m, inv), _exponent(e, ed, cp, off, j0 + 1, m, inv),
+                  _exponent(e, ed, cp, off, j0 + 2, m, inv), _exponent(e, ed, cp, off, j0 + 3, m, inv),
+                  _exponent(e, ed, cp, off, j0 + 4, m, inv), _exponent(e, ed, cp, off, j0 + 5, m, inv),
+                  _exponent(e, ed, cp, off, j0 + 6, m, inv), _exponent(e, ed, cp, off, j0 + 7, m, inv)))
+        for k in range(min(8, m - j0)):
+            psi[j0 + k] = r[k]
 
 
 @njit_noalloc(inline="always")

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._jit import njit_noalloc
+from .._vecmath import sincos4
 from . import _validate as val
 from .layout import KIND_PAPER, KIND_PULSE, P_AMP, P_PHASE, ROW_SIZE, U_END, U_FORCE, U_START
 
@@ -103,8 +104,8 @@ class Pulse:
 def add_paper(rows, k, t, out):
     """Add the paper's disturbance of packed row ``k`` at time ``t`` (s) to ``out`` (5,)."""
     a, p = rows[k, P_AMP], rows[k, P_PHASE]
-    s2, c2 = math.sin(0.2 * math.pi * t + p), math.cos(0.2 * math.pi * t + p)
-    s1, c1 = math.sin(0.1 * math.pi * t + p), math.cos(0.1 * math.pi * t + p)
+    s, c = sincos4((0.2 * math.pi * t + p, 0.1 * math.pi * t + p, 0.0, 0.0))  # one vector call, within 4 ulp
+    s2, c2, s1, c1 = s[0], c[0], s[1], c[1]
     out[0] += a * 3.0 * s2
     out[1] += a * s2
     out[2] += a * c1

@@ -29,12 +29,14 @@ from __future__ import annotations
 import math
 
 from .._jit import njit
+from .._vecmath import sincos4
 
 
 @njit
 def attitude(theta, psi):
-    """Return att = (cos theta, sin theta, cos psi, sin psi)."""
-    return math.cos(theta), math.sin(theta), math.cos(psi), math.sin(psi)
+    """Return att = (cos theta, sin theta, cos psi, sin psi), within 4 ulp (:func:`auvtrack._vecmath.sincos4`)."""
+    s, c = sincos4((theta, psi, 0.0, 0.0))
+    return c[0], s[0], c[1], s[1]
 
 
 @njit

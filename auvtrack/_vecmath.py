@@ -1,0 +1,183 @@
+"""Several libm calls in one: x^p on 4 lanes and exp on 8 lanes, for the compiled laws.
+
+Each RK4 stage of the FXTNTSMC needs z_i = atanh(xi_i), |z_i|^(a2-1) and |S_e,i|^(alpha-1)
+for the three axes (eq. 17, 27-28) and exp for each RBF neuron (eq. 12).  Called one at a time these libm functions
+were about a third of a step (``benchmarks/profile.md``).  glibc's vector math library
+(libmvec, Linux x86-64, glibc >= 2.22) evaluates 4 or 8 lanes in about the time of one or
+two scalar calls, so :func:`pow4` and :func:`exp8` call it directly:
+
+* ``_ZGVdN4vv_pow`` (AVX2, 4 lanes) for :func:`pow4`;
+* ``_ZGVeN8v_exp`` (AVX-512, 8 lanes), or two ``_ZGVdN4v_exp`` (AVX2), for :func:`exp8`;
+* ``_ZGVdN4v_sin`` and ``_ZGVdN4v_cos`` (AVX2, 4 lanes) for :func:`sincos4`: the attitude
+  (theta, psi) of every stage and the two arguments of the paper's disturbance;
+* ``_ZGVdN4v_atanh`` (AVX2, 4 lanes, glibc >= 2.35) for :func:`atanh4`: z of eq. (17), three axes.
+
+libmvec's results are within 4 ulp of the correctly rounded value (glibc manual, "Errors in
+Math Functions"), so they can differ from the scalar libm in the last bits:
+``tests/test_vecmath.py`` pins both to NumPy at 1e-15 relative.  Without libmvec, without
+AVX2 on the compile target, or with ``AUVTRACK_LIBMVEC=0`` the same functions are scalar
+loops over libm (bit-identical to the code before this module).  :data:`BACKEND` names the
+choice, made once at import; the Numba cache directory includes it (``_jit.cache_dir``).
+"""
+from __future__ import annotations
+
+import ctypes.util
+import math
+import os
+import sys
+
+import numba
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
+
+__all__ = ["BACKEND", "pow4", "exp8", "sincos4", "atanh4", "backend"]
+
+SYMBOLS = ("_ZGVdN4vv_pow", "_ZGVdN4v_sin", "_ZGVdN4v_cos", "_ZGVdN4v_atanh")
+SYMBOLS_512, SYMBOLS_256 = ("_ZGVeN8v_exp",), ("_ZGVdN4v_exp",)
+F4 = types.UniTuple(types.float64, 4)
+F8 = types.UniTuple(types.float64, 8)
+
+
+def backend() -> str:
+    """Which implementation this process can use: "avx512", "avx2" (libmvec) or "scalar"."""
+    if os.environ.get("AUVTRACK_LIBMVEC", "1") == "0" or not sys.platform.startswith("linux"):
+        return "scalar"
+    if numba.config.CPU_NAME not in (None, "host"):  # a portable target may lack the vector ABI
+        return "scalar"
+    import llvmlite.binding as ll
+
+    features = ll.get_host_cpu_features()
+    if not features.get("avx2", False):
+        return "scalar"
+    lib = ctypes.util.find_library("mvec")
+    if lib is None:
+        return "scalar"
+    wide = features.get("avx512f", False)
+    try:
+        handle = ctypes.CDLL(lib)
+        if not all(hasattr(handle, name) for name in SYMBOLS + (SYMBOLS_512 if wide else SYMBOLS_256)):
+            return "scalar"  # e.g. glibc < 2.35 has no vector atanh
+        ll.load_library_permanently(lib)
+    except (OSError, RuntimeError):  # pragma: no cover - a libmvec that cannot be loaded
+        return "scalar"
+    return "avx512" if wide else "avx2"
+
+
+BACKEND = backend()
+
+
+def _vector_call(name: str, width: int, nargs: int, parts: int = 1):
+    """Codegen calling the vector-ABI function ``name`` on ``nargs`` tuples of ``width`` floats.
+
+    ``parts`` > 1 splits each tuple into that many calls of ``width // parts`` lanes.
+    """
+    from llvmlite import ir
+
+    lanes = width // parts
+
+    def codegen(context, builder, signature, args):
+        vty = ir.VectorType(ir.DoubleType(), lanes)
+        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(vty, [vty] * nargs), name)
+        outs = []
+        for part in range(parts):
+            vecs = []
+            for a in args:
+                v = ir.Constant(vty, ir.Undefined)
+                for k in range(lanes):
+                    v = builder.insert_element(v, builder.extract_value(a, part * lanes + k),
+                                               ir.Constant(ir.IntType(32), k))
+                vecs.append(v)
+            r = builder.call(fn, vecs)
+            outs += [builder.extract_element(r, ir.Constant(ir.IntType(32), k)) for k in range(lanes)]
+        return context.make_tuple(builder, signature.return_type, outs)
+
+    return codegen
+
+
+@intrinsic
+def _pow4_libmvec(typingctx, x, p):
+    return F4(F4, F4), _vector_call("_ZGVdN4vv_pow", 4, 2)
+
+
+@intrinsic
+def _exp8_libmvec512(typingctx, x):
+    return F8(F8), _vector_call("_ZGVeN8v_exp", 8, 1)
+
+
+@intrinsic
+def _exp8_libmvec256(typingctx, x):
+    return F8(F8), _vector_call("_ZGVdN4v_exp", 8, 1, parts=2)
+
+
+@intrinsic
+def _sin4_libmvec(typingctx, x):
+    return F4(F4), _vector_call("_ZGVdN4v_sin", 4, 1)
+
+
+@intrinsic
+def _cos4_libmvec(typingctx, x):
+    return F4(F4), _vector_call("_ZGVdN4v_cos", 4, 1)
+
+
+@intrinsic
+def _atanh4_libmvec(typingctx, x):
+    return F4(F4), _vector_call("_ZGVdN4v_atanh", 4, 1)
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def _atanh4_scalar(x):
+    return math.atanh(x[0]), math.atanh(x[1]), math.atanh(x[2]), math.atanh(x[3])
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def _sincos4_libmvec(x):
+    return _sin4_libmvec(x), _cos4_libmvec(x)
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def _sincos4_scalar(x):
+    return ((math.sin(x[0]), math.sin(x[1]), math.sin(x[2]), math.sin(x[3])),
+            (math.cos(x[0]), math.cos(x[1]), math.cos(x[2]), math.cos(x[3])))
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def _pow4_scalar(x, p):
+    return x[0] ** p[0], x[1] ** p[1], x[2] ** p[2], x[3] ** p[3]
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def _exp8_scalar(x):
+    return (math.exp(x[0]), math.exp(x[1]), math.exp(x[2]), math.exp(x[3]),
+            math.exp(x[4]), math.exp(x[5]), math.exp(x[6]), math.exp(x[7]))
+
+
+if BACKEND == "scalar":
+    _pow4, _exp8, _sincos4, _atanh4 = _pow4_scalar, _exp8_scalar, _sincos4_scalar, _atanh4_scalar
+else:
+    _pow4, _sincos4, _atanh4 = _pow4_libmvec, _sincos4_libmvec, _atanh4_libmvec
+    _exp8 = _exp8_libmvec512 if BACKEND == "avx512" else _exp8_libmvec256
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def pow4(x, p):
+    """(x_k^p_k for k < 4) of two 4-tuples, within 4 ulp of libm's ``**`` (compiled code only)."""
+    return _pow4(x, p)
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def exp8(x):
+    """(exp(x_k) for k < 8) of an 8-tuple, within 4 ulp of libm's exp (compiled code only)."""
+    return _exp8(x)
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def sincos4(x):
+    """((sin x_k), (cos x_k)) of a 4-tuple, each within 4 ulp of libm (compiled code only)."""
+    return _sincos4(x)
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def atanh4(x):
+    """(atanh x_k) of a 4-tuple, within 4 ulp of libm (compiled code only)."""
+    return _atanh4(x)

@@ -1,0 +1,243 @@
+"""Vector libm calls (auvtrack._vecmath) against NumPy, and the law's use of them."""
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+
+import numba
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from auvtrack import _jit, _vecmath
+from auvtrack._vecmath import atanh4, exp8, pow4, sincos4
+from auvtrack.control import fxtntsmc, rbf
+
+MAX_ULP = 4  # glibc's bound for libmvec (manual, "Errors in Math Functions")
+
+
+@numba.njit(error_model="numpy")
+def _pow4_array(x, p, out):
+    for i in range(0, x.shape[0], 4):
+        out[i], out[i + 1], out[i + 2], out[i + 3] = pow4((x[i], x[i + 1], x[i + 2], x[i + 3]),
+                                                          (p[i], p[i + 1], p[i + 2], p[i + 3]))
+
+
+@numba.njit(error_model="numpy")
+def _exp8_array(x, out):
+    for i in range(0, x.shape[0], 8):
+        r = exp8((x[i], x[i + 1], x[i + 2], x[i + 3], x[i + 4], x[i + 5], x[i + 6], x[i + 7]))
+        for k in range(8):
+            out[i + k] = r[k]
+
+
+@numba.njit(error_model="numpy")
+def _scalar_pow4(x, p):
+    return _vecmath._pow4_scalar(x, p)
+
+
+@numba.njit(error_model="numpy")
+def _scalar_exp8(x):
+    return _vecmath._exp8_scalar(x)
+
+
+@numba.njit(error_model="numpy")
+def _powers_below3(x, p, need):
+    return fxtntsmc.powers_below3(x, p, need)
+
+
+def test_backend_is_vector_where_libmvec_exists():
+    """On Linux x86-64 with AVX2 and glibc's libmvec the vector calls are used (this CI machine)."""
+    import ctypes.util
+
+    import llvmlite.binding as ll
+
+    expected_vector = (sys.platform.startswith("linux") and ctypes.util.find_library("mvec") is not None
+                       and ll.get_host_cpu_features().get("avx2", False)
+                       and os.environ.get("AUVTRACK_LIBMVEC", "1") != "0")
+    assert (_vecmath.BACKEND != "scalar") == expected_vector
+    assert _vecmath.BACKEND in ("avx512", "avx2", "scalar")
+
+
+def test_cache_directory_names_the_backend():
+    assert _jit.cache_dir().name.endswith("-" + _vecmath.BACKEND)
+
+
+def test_libmvec_can_be_switched_off():
+    """AUVTRACK_LIBMVEC=0 selects the scalar loops (and therefore another cache directory)."""
+    code = "import auvtrack._vecmath as v, auvtrack._jit as j; print(v.BACKEND, j.cache_dir().name)"
+    out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "AUVTRACK_LIBMVEC": "0"},
+                         capture_output=True, text=True, check=True).stdout.split()
+    assert out[0] == "scalar" and out[1].endswith("-scalar")
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(1e-12, 1e6), min_size=4, max_size=4),
+       st.lists(st.floats(-3.0, 3.0), min_size=4, max_size=4))
+def test_pow4_matches_numpy_power(x, p):
+    x, p = np.array(x), np.array(p)
+    out = np.empty(4)
+    _pow4_array(x, p, out)
+    np.testing.assert_array_max_ulp(out, np.power(x, p), maxulp=MAX_ULP)
+
+
+def test_pow4_on_many_bases_and_the_law_exponents():
+    rng = np.random.default_rng(3)
+    x = np.concatenate([rng.uniform(1e-9, 1.0, 4000), rng.uniform(1.0, 50.0, 4000)])
+    for q in (-0.2, -0.4, 0.5, 1.0, 2.5):  # a2 - 1 and alpha - 1 of Section 4 among them
+        out = np.empty_like(x)
+        _pow4_array(x, np.full_like(x, q), out)
+        np.testing.assert_array_max_ulp(out, np.power(x, q), maxulp=MAX_ULP)
+
+
+def test_pow4_edge_values_follow_ieee_pow():
+    x = np.array([0.0, 0.0, 1.0, np.inf])
+    p = np.array([-0.2, 0.5, -0.4, -0.2])
+    out = np.empty(4)
+    _pow4_array(x, p, out)
+    np.testing.assert_array_equal(out, [np.inf, 0.0, 1.0, 0.0])
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(-700.0, 700.0), min_size=8, max_size=8))
+def test_exp8_matches_numpy_exp(x):
+    x = np.array(x)
+    out = np.empty(8)
+    _exp8_array(x, out)
+    np.testing.assert_array_max_ulp(out, np.exp(x), maxulp=MAX_ULP)
+
+
+def test_exp8_underflows_to_zero_like_exp():
+    x = np.array([-800.0, -745.2, 0.0, -1e-300, -50.0, -1e3, -np.inf, 1.0])
+    out = np.empty(8)
+    _exp8_array(x, out)
+    ref = np.exp(x)
+    np.testing.assert_array_max_ulp(out, ref, maxulp=MAX_ULP)
+    assert out[0] == 0.0 and out[5] == 0.0 and out[6] == 0.0 and out[2] == 1.0
+
+
+def test_scalar_fallback_is_libm_bit_for_bit():
+    x, p = (0.3, 1.7, 1e-6, 4.0), (-0.2, -0.4, 0.8, 1.0)
+    assert _scalar_pow4(x, p) == tuple(a**b for a, b in zip(x, p))
+    y = (-1.0, -0.5, 0.0, 0.25, -30.0, -700.0, 3.0, -1e-9)
+    assert _scalar_exp8(y) == tuple(math.exp(v) for v in y)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.tuples(st.floats(1e-9, 10.0), st.floats(1e-9, 10.0), st.floats(1e-9, 10.0)),
+       st.sampled_from([0.6, 0.8, 0.5756, 1.5, 2.0]),
+       st.tuples(st.booleans(), st.booleans(), st.booleans()))
+def test_powers_below3_pins_to_power_below(x, p, need):
+    """Needed lanes within 4 ulp of power_below (exactly it when only one is needed), others 1; p = 2 gives x."""
+    q = _powers_below3(x, p, need)
+    if p == 2.0:
+        assert q == x
+        return
+    for k in range(3):
+        ref = fxtntsmc.power_below.py_func(x[k], p)
+        if not need[k]:
+            assert q[k] == 1.0 or sum(need) >= 2
+        elif sum(need) == 1:
+            assert q[k] == ref
+        else:
+            np.testing.assert_array_max_ulp(q[k], ref, maxulp=MAX_ULP)
+
+
+@numba.njit(error_model="numpy")
+def _basis(e, ed, cp, m, width, psi):
+    rbf.basis(e, ed, cp, 0, m, width, psi)
+
+
+@pytest.mark.parametrize("m", [1, 7, 8, 9, 20])
+def test_rbf_basis_matches_eq12_for_any_neuron_count(m):
+    """psi_j = exp(-||x - c_j||^2 / (2 b^2)) within 4 ulp, padding lanes never written."""
+    rng = np.random.default_rng(m)
+    centres = rng.uniform(-1.0, 1.0, (m, 6))
+    e, ed = tuple(rng.normal(size=3)), tuple(rng.normal(size=3))
+    psi = np.full(m + 8, -1.0)
+    _basis(e, ed, centres.ravel(), m, 1.3, psi)
+    inv = 1.0 / (2.0 * 1.3 * 1.3)
+    ref = []
+    for c in centres:  # the kernel's order of summation, so that only exp may differ
+        d2 = 0.0
+        for k in range(3):
+            d2 += (e[k] - c[k]) ** 2 + (ed[k] - c[3 + k]) ** 2
+        ref.append(math.exp(-d2 * inv))
+    np.testing.assert_array_max_ulp(psi[:m], np.array(ref), maxulp=MAX_ULP)
+    assert np.all(psi[m:] == -1.0)
+
+
+def _law_points(tmp_path, backend_env: str, given=None) -> dict:
+    out = tmp_path / f"law-{backend_env}.npz"
+    subprocess.run([sys.executable, "tests/law_points.py", str(out)] + ([str(given)] if given else []),
+                   check=True, env={**os.environ, "AUVTRACK_LIBMVEC": backend_env})
+    return dict(np.load(out))
+
+
+@pytest.mark.skipif(_vecmath.BACKEND == "scalar", reason="only one back end on this machine")
+def test_vector_law_matches_the_libm_law(tmp_path):
+    """The FXTNTSMC law with libmvec equals the libm (scalar) law to 1e-14 of each output's scale.
+
+    3000 seeded states over the envelope, both branches of eq. (27) and of the nonsingular
+    surface on every axis, each back end compiled in its own process.
+    """
+    vec = _law_points(tmp_path, "1")
+    ref = _law_points(tmp_path, "0", given=tmp_path / "law-1.npz")
+    assert np.array_equal(vec["Xs"], ref["Xs"]) and np.all(ref["status"] == 0) and np.all(vec["status"] == 0)
+    z = ref["auxs"][:, 15:18]
+    assert 0.1 < np.mean(np.abs(z) <= 0.01) < 0.9  # both branches of the surface are exercised
+    se = np.array([fxtntsmc.surface(v, 0.8, 0.8, 0.8, 2.0, False, 0.01, 1e-6)[0] for v in z.ravel()])
+    assert 0.1 < np.mean(np.abs(se) > 0.005) < 0.9  # and both of eq. (27)
+    for key in ("taus", "dXs", "auxs"):
+        scale = np.abs(ref[key]).max(axis=0)
+        assert np.all(np.abs(vec[key] - ref[key]) <= 1e-14 * scale), key
+    assert not np.array_equal(vec["taus"], ref["taus"])  # the two back ends really differ
+
+
+@numba.njit(error_model="numpy")
+def _sincos4_array(x, s_out, c_out):
+    for i in range(0, x.shape[0], 4):
+        s, c = sincos4((x[i], x[i + 1], x[i + 2], x[i + 3]))
+        for k in range(4):
+            s_out[i + k], c_out[i + k] = s[k], c[k]
+
+
+@numba.njit(error_model="numpy")
+def _atanh4_array(x, out):
+    for i in range(0, x.shape[0], 4):
+        out[i], out[i + 1], out[i + 2], out[i + 3] = atanh4((x[i], x[i + 1], x[i + 2], x[i + 3]))
+
+
+def test_sincos4_matches_numpy_on_angles_and_disturbance_arguments():
+    rng = np.random.default_rng(5)
+    x = np.concatenate([rng.uniform(-np.pi, np.pi, 4000), rng.uniform(0.0, 200.0, 4000),  # 0.2 pi t, t <= 300 s
+                        [0.0, -0.0, 1e-300, np.pi / 2]])
+    x = np.concatenate([x, np.zeros(-x.size % 4)])
+    s, c = np.empty_like(x), np.empty_like(x)
+    _sincos4_array(x, s, c)
+    # ulps relative to the magnitude 1 of sin and cos (near a zero the relative error is meaningless)
+    assert np.max(np.abs(s - np.sin(x))) <= MAX_ULP * np.spacing(1.0)
+    assert np.max(np.abs(c - np.cos(x))) <= MAX_ULP * np.spacing(1.0)
+    big = np.abs(np.sin(x)) > 0.5
+    np.testing.assert_array_max_ulp(s[big], np.sin(x[big]), maxulp=MAX_ULP)
+
+
+def test_atanh4_matches_numpy_over_the_envelope_ratio():
+    rng = np.random.default_rng(6)
+    x = np.concatenate([10.0 ** rng.uniform(-12, 0, 4000) * rng.choice([-1, 1], 4000),
+                        rng.uniform(-0.999999, 0.999999, 4000), [0.0, -0.0, 0.5, -0.5]])
+    out = np.empty_like(x)
+    _atanh4_array(x, out)
+    np.testing.assert_array_max_ulp(out, np.arctanh(x), maxulp=MAX_ULP)
+
+
+def test_attitude_is_within_4_ulp_of_libm():
+    from auvtrack.plant.kinematics import attitude
+
+    for th, ps in ((0.0, 0.0), (0.3, -2.0), (-1.4, 3.1), (1e-8, 100.0)):
+        got = np.array(attitude(th, ps))
+        want = np.array([math.cos(th), math.sin(th), math.cos(ps), math.sin(ps)])
+        assert np.max(np.abs(got - want)) <= MAX_ULP * np.spacing(1.0)
