@@ -200,24 +200,20 @@ def _transform(kind, shape, cp, eprm, e, ed, X, i):
 
 
 @njit_noalloc(inline="always")
-def _finish_axis(i, tr, z, se, dse, qs, ed_i, X, cp, est, m, work, dX, aux):
-    """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27), the commanded e_ddot (eq. 32-34, ERRATA 13), estimate, logs.
+def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dX, aux):
+    """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27) and the commanded e_ddot (eq. 32, ERRATA 13).
 
-    Writes ``work[ACC + i]`` (commanded e_ddot minus the estimate), dX of rho_bar_i and of
-    W_i, and the aux channels; ``qs`` = power_below(|S_e|, alpha).
+    Returns (S, e_ddot, gain of the estimator's update); writes dX of rho_bar_i and the aux channels
+    except chi_hat.
     """
     _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
     s1, dphi = switch_q(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2], qs)
     S = zd + s1
     reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
     edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / (Om - c1)
-    chat = 0.0
-    if est != rbf.NONE:
-        gain = Om if est == rbf.OMEGA else 1.0
-        chat = rbf.estimate_and_adapt(X, XC + 3 + i * m, m, work, S, gain, dX)
-    work[ACC + i] = edd - chat
     dX[XC + i] = rbd
-    aux[i], aux[3 + i], aux[6 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, chat, S, g, z
+    aux[i], aux[3 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, S, g, z
+    return S, edd, Om
 
 
 @njit_noalloc(inline="always")
@@ -260,10 +256,15 @@ def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     se2, dse2 = surface_q(z[2], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[2])
     ase = (abs(se0), abs(se1), abs(se2))
     qs = powers_below3(ase, cp[ALPHA], (ase[0] > cp[SIGMA], ase[1] > cp[SIGMA], ase[2] > cp[SIGMA]))
-    _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], X, cp, est, m, work, dX, aux)
-    _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], X, cp, est, m, work, dX, aux)
-    _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], X, cp, est, m, work, dX, aux)
-    acc = (work[ACC], work[ACC + 1], work[ACC + 2])
+    S0, edd0, om0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dX, aux)
+    S1, edd1, om1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dX, aux)
+    S2, edd2, om2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dX, aux)
+    chat = (0.0, 0.0, 0.0)
+    if est != rbf.NONE:
+        gain = (om0, om1, om2) if est == rbf.OMEGA else (1.0, 1.0, 1.0)
+        chat = rbf.estimate_and_adapt3(X, XC + 3, m, work, (S0, S1, S2), gain, dX)
+    aux[6], aux[7], aux[8] = chat
+    acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])
     tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, acc, gf)
     return 0
 

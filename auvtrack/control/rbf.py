@@ -72,6 +72,33 @@ def estimate_and_adapt(X, off, m, psi, S_i, gain, dX):
     return chat
 
 
+@njit_noalloc(inline="always")
+def estimate_and_adapt3(X, off, m, psi, S, gain, dX):
+    """:func:`estimate_and_adapt` of the three axes in one pass over the neurons (same numbers).
+
+    Axis i's weights are X[off + i m : off + (i + 1) m]; S and gain are 3-tuples.
+    """
+    c0 = c1 = c2 = 0.0
+    n0 = n1 = n2 = 0.0
+    for j in range(m):
+        k = np.uintp(off + j)
+        p = psi[j]
+        a, b, c = X[k], X[k + m], X[k + 2 * m]
+        c0 += a * p
+        c1 += b * p
+        c2 += c * p
+        n0 += a * a
+        n1 += b * b
+        n2 += c * c
+    for j in range(m):
+        k = np.uintp(off + j)
+        p = psi[j]
+        dX[k] = gain[0] * p * S[0] - X[k] * n0
+        dX[k + m] = gain[1] * p * S[1] - X[k + m] * n1
+        dX[k + 2 * m] = gain[2] * p * S[2] - X[k + 2 * m] * n2
+    return c0, c1, c2
+
+
 def draw_network(seed: int, neurons: int, centre_range, weight_range) -> tuple[np.ndarray, np.ndarray]:
     """Seeded centres (m, 6) and initial weights (3, m) of the network."""
     g = rng(seed, "rbf")
