@@ -7,7 +7,8 @@ were about a third of a step (``benchmarks/profile.md``).  glibc's vector math l
 two scalar calls, so :func:`pow4` and :func:`exp8` call it directly:
 
 * ``_ZGVdN4vv_pow`` (AVX2, 4 lanes) for :func:`pow4`;
-* ``_ZGVeN8v_exp`` (AVX-512, 8 lanes), or two ``_ZGVdN4v_exp`` (AVX2), for :func:`exp8`;
+* two ``_ZGVdN4v_exp`` (AVX2, 4 lanes) for :func:`exp8` (libmvec's 8-lane AVX-512 exp gives the same
+  numbers but made the FXTNTSMC 5 % slower here, ``benchmarks/profile.md``);
 * ``_ZGVdN4v_sin`` and ``_ZGVdN4v_cos`` (AVX2, 4 lanes) for :func:`sincos4`: the attitude
   (theta, psi) of every stage and the two arguments of the paper's disturbance;
 * ``_ZGVdN4v_atanh`` (AVX2, 4 lanes, glibc >= 2.35) for :func:`atanh4`: z of eq. (17), three axes.
@@ -33,14 +34,13 @@ from numba.extending import intrinsic
 
 __all__ = ["BACKEND", "pow4", "exp8", "sincos4", "atanh4", "backend"]
 
-SYMBOLS = ("_ZGVdN4vv_pow", "_ZGVdN4v_sin", "_ZGVdN4v_cos", "_ZGVdN4v_atanh")
-SYMBOLS_512, SYMBOLS_256 = ("_ZGVeN8v_exp",), ("_ZGVdN4v_exp",)
+SYMBOLS = ("_ZGVdN4vv_pow", "_ZGVdN4v_exp", "_ZGVdN4v_sin", "_ZGVdN4v_cos", "_ZGVdN4v_atanh")
 F4 = types.UniTuple(types.float64, 4)
 F8 = types.UniTuple(types.float64, 8)
 
 
 def backend() -> str:
-    """Which implementation this process can use: "avx512", "avx2" (libmvec) or "scalar"."""
+    """Which implementation this process can use: "avx2" (libmvec) or "scalar"."""
     if os.environ.get("AUVTRACK_LIBMVEC", "1") == "0" or not sys.platform.startswith("linux"):
         return "scalar"
     if numba.config.CPU_NAME not in (None, "host"):  # a portable target may lack the vector ABI
@@ -53,15 +53,14 @@ def backend() -> str:
     lib = ctypes.util.find_library("mvec")
     if lib is None:
         return "scalar"
-    wide = features.get("avx512f", False)
     try:
         handle = ctypes.CDLL(lib)
-        if not all(hasattr(handle, name) for name in SYMBOLS + (SYMBOLS_512 if wide else SYMBOLS_256)):
+        if not all(hasattr(handle, name) for name in SYMBOLS):
             return "scalar"  # e.g. glibc < 2.35 has no vector atanh
         ll.load_library_permanently(lib)
     except (OSError, RuntimeError):  # pragma: no cover - a libmvec that cannot be loaded
         return "scalar"
-    return "avx512" if wide else "avx2"
+    return "avx2"
 
 
 BACKEND = backend()
@@ -101,12 +100,7 @@ def _pow4_libmvec(typingctx, x, p):
 
 
 @intrinsic
-def _exp8_libmvec512(typingctx, x):
-    return F8(F8), _vector_call("_ZGVeN8v_exp", 8, 1)
-
-
-@intrinsic
-def _exp8_libmvec256(typingctx, x):
+def _exp8_libmvec(typingctx, x):
     return F8(F8), _vector_call("_ZGVdN4v_exp", 8, 1, parts=2)
 
 
@@ -155,8 +149,7 @@ def _exp8_scalar(x):
 if BACKEND == "scalar":
     _pow4, _exp8, _sincos4, _atanh4 = _pow4_scalar, _exp8_scalar, _sincos4_scalar, _atanh4_scalar
 else:
-    _pow4, _sincos4, _atanh4 = _pow4_libmvec, _sincos4_libmvec, _atanh4_libmvec
-    _exp8 = _exp8_libmvec512 if BACKEND == "avx512" else _exp8_libmvec256
+    _pow4, _exp8, _sincos4, _atanh4 = _pow4_libmvec, _exp8_libmvec, _sincos4_libmvec, _atanh4_libmvec
 
 
 @numba.njit(inline="always", _nrt=False, error_model="numpy")

@@ -41,8 +41,8 @@ def _exponent(e, ed, cp, off, j, m, inv):
 def basis(e, ed, cp, off, m, width, psi):
     """Gaussian basis psi(x) of eq. (12), x = [e, e_dot], written to psi[0:m].
 
-    psi_j = exp(-||x - c_j||^2 / (2 b^2)), b = ``width``, eight neurons per vector exp
-    (:func:`auvtrack._vecmath.exp8`, within 4 ulp of libm's exp).  The centres are
+    psi_j = exp(-||x - c_j||^2 / (2 b^2)), b = ``width``, eight neurons per
+    :func:`auvtrack._vecmath.exp8` (two 4-lane libmvec calls, within 4 ulp of libm's exp).  The centres are
     ``cp[off : off + 6 m]``, row j = (c_e (3), c_e_dot (3)).
     """
     inv = 1.0 / (2.0 * width * width)
