@@ -1,10 +1,10 @@
-"""Several libm calls in one: x^p on 4 lanes and exp on 8 lanes, for the compiled laws.
+"""Several libm calls in one (pow, exp, sin/cos, atanh on 4 lanes) for the compiled laws.
 
 Each RK4 stage of the FXTNTSMC needs z_i = atanh(xi_i), |z_i|^(a2-1) and |S_e,i|^(alpha-1)
-for the three axes (eq. 17, 27-28) and exp for each RBF neuron (eq. 12).  Called one at a time these libm functions
-were about a third of a step (``benchmarks/profile.md``).  glibc's vector math library
-(libmvec, Linux x86-64, glibc >= 2.22) evaluates 4 or 8 lanes in about the time of one or
-two scalar calls, so :func:`pow4` and :func:`exp8` call it directly:
+for the three axes (eq. 17, 27-28) and exp for each RBF neuron (eq. 12).  Called one at a
+time, libm functions were about half of a step (``benchmarks/profile.md``).  glibc's vector
+math library (libmvec, Linux x86-64) evaluates 4 lanes in about the time of one or two scalar
+calls, so these functions call it directly:
 
 * ``_ZGVdN4vv_pow`` (AVX2, 4 lanes) for :func:`pow4`;
 * two ``_ZGVdN4v_exp`` (AVX2, 4 lanes) for :func:`exp8` (libmvec's 8-lane AVX-512 exp gives the same
@@ -15,7 +15,8 @@ two scalar calls, so :func:`pow4` and :func:`exp8` call it directly:
 
 libmvec's results are within 4 ulp of the correctly rounded value (glibc manual, "Errors in
 Math Functions"), so they can differ from the scalar libm in the last bits:
-``tests/test_vecmath.py`` pins both to NumPy at 1e-15 relative.  Without libmvec, without
+``tests/test_vecmath.py`` pins each function to NumPy within 4 ulp, and the law using them to the
+libm law within 1e-14 of each output's scale.  Without libmvec, without
 AVX2 on the compile target, or with ``AUVTRACK_LIBMVEC=0`` the same functions are scalar
 loops over libm (bit-identical to the code before this module).  :data:`BACKEND` names the
 choice, made once at import; the Numba cache directory includes it (``_jit.cache_dir``).

@@ -27,3 +27,31 @@ def test_cli_bench_prints_one_json_line_per_controller():
     assert out.exit_code == 0, out.output
     lines = [json.loads(x) for x in out.output.strip().splitlines()]
     assert [x["controller"] for x in lines] == ["ftsmc"]
+
+
+def test_results_name_the_vector_math_back_end(tmp_path):
+    """Results depend on the vector-math back end (auvtrack._vecmath), so the record says which."""
+    from pathlib import Path
+
+    from auvtrack import _vecmath
+    from auvtrack.studies.bench import machine
+    from auvtrack.studies.sweep_bench import write_results
+
+    m = machine()
+    assert m["vector_math"] == _vecmath.BACKEND
+    doc = json.loads(Path("benchmarks/results.json").read_text())  # a real record, re-written with this machine
+    doc.pop("date")
+    doc["machine"] = m
+    write_results(doc, tmp_path)
+    assert f"vector math {_vecmath.BACKEND} " in (tmp_path / "results.md").read_text()
+    assert json.loads((tmp_path / "results.json").read_text())["machine"]["vector_math"] == _vecmath.BACKEND
+
+
+def test_batch_rows_cover_every_controller_and_back_end():
+    from auvtrack.studies.sweep_bench import bench_batch
+
+    rows = bench_batch(repeat=2, runs=3, duration=0.02)
+    assert [(r["controller"], r["backend"]) for r in rows] == [
+        (k, b) for k in ("ftsmc", "fxtntsmc") for b in ("serial", "threads", "prange")]
+    for r in rows:
+        assert r["runs"] == 3 and r["repeat"] == 2 and 0 < r["runs_per_s"] <= r["max_runs_per_s"]

@@ -17,8 +17,10 @@ def paper_scenario_path() -> Path:
 
 
 def machine() -> dict:
-    """Short description of this machine for benchmark records (CPU model, cores, load, versions)."""
+    """Short description of this machine for benchmark records (CPU model, cores, load, versions, vector math)."""
     import numba
+
+    from .._vecmath import BACKEND
 
     cpu = platform.processor() or platform.machine()
     try:
@@ -33,7 +35,7 @@ def machine() -> dict:
     except OSError:
         load = None
     return {"python": platform.python_version(), "cpu": cpu, "cores": os.cpu_count(), "system": platform.system(),
-            "numba": numba.__version__, "load_avg_1_5_15": load}
+            "numba": numba.__version__, "load_avg_1_5_15": load, "vector_math": BACKEND}
 
 
 def _prepared(kind: str, duration: float):

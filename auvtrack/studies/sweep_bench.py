@@ -95,18 +95,20 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
         t0 = time.perf_counter()
         preps[kind] = _preps(kind, runs, duration)
         prep_ms[kind] = 1e3 * (time.perf_counter() - t0) / runs
-        for backend in backends:
-            run_batch(preps[kind][:2], backend=backend)  # warm
+        for backend in ("prange", "serial", "threads"):  # warm; prange first (see below)
+            run_batch(preps[kind][:2], backend=backend)
     rates: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
-    # controllers interleaved (a slow spell of the machine hits both alike), back ends one after
-    # the other: after a prange call the OpenMP layer's threads keep spinning for a while and
-    # would steal the core from a serial or thread-pool run that followed at once
-    for backend in backends:
+    # controllers and the serial and thread-pool back ends interleaved (a slow spell of the
+    # machine hits them alike); prange in a block of its own, last: after a prange call the
+    # OpenMP layer's threads keep spinning for a while and would steal the core from a serial
+    # or thread-pool run that followed at once
+    for block in (("serial", "threads"), ("prange",)):
         for _ in range(repeat):
-            for kind in kinds:
-                t0 = time.perf_counter()
-                run_batch(preps[kind], backend=backend)
-                rates[(kind, backend)].append(runs / (time.perf_counter() - t0))
+            for backend in block:
+                for kind in kinds:
+                    t0 = time.perf_counter()
+                    run_batch(preps[kind], backend=backend)
+                    rates[(kind, backend)].append(runs / (time.perf_counter() - t0))
     return [{"controller": kind, "backend": backend, "runs": runs, "run_seconds": duration,
              "runs_per_s": round(statistics.median(r), 2), "max_runs_per_s": round(max(r), 2),
              "prepare_ms_per_run": round(prep_ms[kind], 3), "cores": default_workers(), "repeat": repeat,
@@ -167,10 +169,13 @@ def write_results(doc: dict, out: Path) -> None:
     single = {r["controller"]: r for r in doc["single"]}
     lines = ["# Benchmark results", "",
              f"Measured {doc['date']} with `auvtrack bench --all` on {m['cpu']}, {m['cores']} cores, "
-             f"Python {m['python']}, Numba {m['numba']}; load average at the start {m['load_avg_1_5_15']} "
+             f"Python {m['python']}, Numba {m['numba']}, vector math {m.get('vector_math', 'scalar')} "
+             "(`auvtrack._vecmath`); "
+             f"load average at the start {m['load_avg_1_5_15']} "
              "(a shared, noisy machine: medians of "
              f"{doc['repeat']} repetitions, {3 * doc['repeat']} for the single runs, taken round-robin over the "
-             "rows of each table so that a slow spell of the machine hits every row alike; the CPU-time column "
+             "rows of each table so that a slow spell of the machine hits every row alike (the batch's prange rows in "
+             "a block of their own, after the others); the CPU-time column "
              "is less sensitive to other processes).", ""]
     load = m.get("load_avg_1_5_15") or [0.0]
     if load[0] > 0.5 * (m.get("cores") or 1):
