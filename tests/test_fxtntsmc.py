@@ -230,3 +230,13 @@ def test_reaching_law_is_eq32(S, k1, k2, k3):
 
     want = -k1 * sign(S) - k2 * sig(S, 3.0) - k3 * S
     assert reaching_law(S, k1, k2, k3) == pytest.approx(want, rel=1e-12, abs=1e-300)
+
+
+def test_the_network_may_fill_the_whole_scratch_array():
+    """The basis of eq. (12) is written to work[0:m], m up to WORK_SIZE, eight neurons per vector exp."""
+    from auvtrack.control.dispatch import WORK_SIZE
+
+    res = _quiet(PAPER, [f"estimator.neurons={WORK_SIZE}", "sim.duration=0.05"])
+    assert res.ok and np.isfinite(res["chi_hat_x"]).all()
+    with pytest.raises(ValueError, match=f"estimator.neurons: at most {WORK_SIZE}"):
+        prepare(load_scenario(PAPER, [f"estimator.neurons={WORK_SIZE + 1}", "sim.duration=0.05"]))

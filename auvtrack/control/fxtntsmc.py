@@ -50,8 +50,7 @@ SC1, SC2, SB1, SB2 = 27, 28, 29, 30
 EST, NEUR, WIDTH, CENT = 31, 32, 33, 34
 SURFACES = {"nonsingular": 0, "printed": 1}
 XC = NX_PLANT  # internal state [rho_bar (3), W (3 m)] starts here in X
-ACC = WORK_SIZE - 3  # scratch slots of the commanded e_ddot
-MAX_NEURONS = ACC  # the basis psi occupies work[0:m]
+MAX_NEURONS = WORK_SIZE  # the basis psi occupies work[0:m]
 
 
 class StartOutsideEnvelope(ValueError):
@@ -220,7 +219,7 @@ def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dX, aux):
 def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     """Compiled FXTNTSMC law, eq. (26)-(34) corrected (tau in N, N m); status 1 if an error leaves its envelope.
 
-    ``work[0:m]`` holds the RBF basis and ``work[ACC:ACC + 3]`` the commanded e_ddot.
+    ``work[0:m]`` holds the RBF basis.
     """
     e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
     kind, est, m = int(cp[ENV]), int(cp[EST]), int(cp[NEUR])
