@@ -95,6 +95,7 @@ def _vector_call(name: str, width: int, nargs: int, parts: int = 1):
     return codegen
 
 
+# libmvec, AVX2 vector ABI: one call per 4 lanes
 @intrinsic
 def _pow4_libmvec(typingctx, x, p):
     return F4(F4, F4), _vector_call("_ZGVdN4vv_pow", 4, 2)
@@ -121,21 +122,11 @@ def _atanh4_libmvec(typingctx, x):
 
 
 @numba.njit(inline="always", _nrt=False, error_model="numpy")
-def _atanh4_scalar(x):
-    return math.atanh(x[0]), math.atanh(x[1]), math.atanh(x[2]), math.atanh(x[3])
-
-
-@numba.njit(inline="always", _nrt=False, error_model="numpy")
 def _sincos4_libmvec(x):
     return _sin4_libmvec(x), _cos4_libmvec(x)
 
 
-@numba.njit(inline="always", _nrt=False, error_model="numpy")
-def _sincos4_scalar(x):
-    return ((math.sin(x[0]), math.sin(x[1]), math.sin(x[2]), math.sin(x[3])),
-            (math.cos(x[0]), math.cos(x[1]), math.cos(x[2]), math.cos(x[3])))
-
-
+# scalar twins: the libm calls the code made before this module, lane by lane
 @numba.njit(inline="always", _nrt=False, error_model="numpy")
 def _pow4_scalar(x, p):
     return x[0] ** p[0], x[1] ** p[1], x[2] ** p[2], x[3] ** p[3]
@@ -147,6 +138,17 @@ def _exp8_scalar(x):
             math.exp(x[4]), math.exp(x[5]), math.exp(x[6]), math.exp(x[7]))
 
 
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def _sincos4_scalar(x):
+    return ((math.sin(x[0]), math.sin(x[1]), math.sin(x[2]), math.sin(x[3])),
+            (math.cos(x[0]), math.cos(x[1]), math.cos(x[2]), math.cos(x[3])))
+
+
+@numba.njit(inline="always", _nrt=False, error_model="numpy")
+def _atanh4_scalar(x):
+    return math.atanh(x[0]), math.atanh(x[1]), math.atanh(x[2]), math.atanh(x[3])
+
+
 if BACKEND == "scalar":
     _pow4, _exp8, _sincos4, _atanh4 = _pow4_scalar, _exp8_scalar, _sincos4_scalar, _atanh4_scalar
 else:
@@ -155,23 +157,23 @@ else:
 
 @numba.njit(inline="always", _nrt=False, error_model="numpy")
 def pow4(x, p):
-    """(x_k^p_k for k < 4) of two 4-tuples, within 4 ulp of libm's ``**`` (compiled code only)."""
+    """(x_k^p_k for k < 4) of two 4-tuples, within 4 ulp of the exact value (compiled code only)."""
     return _pow4(x, p)
 
 
 @numba.njit(inline="always", _nrt=False, error_model="numpy")
 def exp8(x):
-    """(exp(x_k) for k < 8) of an 8-tuple, within 4 ulp of libm's exp (compiled code only)."""
+    """(exp(x_k) for k < 8) of an 8-tuple, within 4 ulp of the exact value (compiled code only)."""
     return _exp8(x)
 
 
 @numba.njit(inline="always", _nrt=False, error_model="numpy")
 def sincos4(x):
-    """((sin x_k), (cos x_k)) of a 4-tuple, each within 4 ulp of libm (compiled code only)."""
+    """((sin x_k), (cos x_k)) of a 4-tuple, each within 4 ulp of the exact value (compiled code only)."""
     return _sincos4(x)
 
 
 @numba.njit(inline="always", _nrt=False, error_model="numpy")
 def atanh4(x):
-    """(atanh x_k) of a 4-tuple, within 4 ulp of libm (compiled code only)."""
+    """(atanh x_k) of a 4-tuple, within 4 ulp of the exact value (compiled code only)."""
     return _atanh4(x)
