@@ -4,7 +4,8 @@ Numba's on-disk cache is keyed by the timestamp of the file that defines a funct
 files it calls, so editing ``plant/dynamics.py`` would leave a stale cached ``simulation/engine.py``
 kernel.  We therefore place the cache in a directory named by a hash of *all* package sources:
 any source change selects a fresh directory.  The name also carries the vector-math back end of
-:mod:`auvtrack._vecmath` (compiled code differs between them).  Set ``AUVTRACK_CACHE_DIR`` to override the root.
+:mod:`auvtrack._vecmath` (compiled code differs between them).  Set ``AUVTRACK_CACHE_DIR`` to
+override the root.
 """
 from __future__ import annotations
 

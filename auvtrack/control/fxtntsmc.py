@@ -91,10 +91,11 @@ def pow_and_power_below(x, p):
 
 @njit_noalloc(inline="always")
 def powers_below3(x, p, need):
-    """:func:`power_below` of the bases ``x`` (3-tuple) where ``need`` (3 booleans) says so, else 1.
+    """:func:`power_below` of the bases ``x`` (3-tuple) for the lanes where ``need`` (3 booleans) is true.
 
-    Two or three needed powers take one vector call (:func:`auvtrack._vecmath.pow4`, within
-    4 ulp of :func:`power_below`), a single one a scalar call; exactly the bases when p = 2.
+    Two or three needed powers take one vector call (:func:`auvtrack._vecmath.pow4`), which
+    returns every lane within 4 ulp of :func:`power_below`; a single needed power is one scalar
+    call (exactly :func:`power_below`) and the other lanes are 1.  p = 2 returns the bases.
     """
     if p == 2.0:
         return x
@@ -202,8 +203,8 @@ def _transform(kind, shape, cp, eprm, e, ed, X, i):
 def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dX, aux):
     """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27) and the commanded e_ddot (eq. 32, ERRATA 13).
 
-    Returns (S, e_ddot, gain of the estimator's update); writes dX of rho_bar_i and the aux channels
-    except chi_hat.
+    Returns (S (m/s), e_ddot (m/s^2), Omega_i); writes dX of rho_bar_i and the aux channels except
+    chi_hat, which the estimator's update of the three axes fills in afterwards.
     """
     _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
     s1, dphi = switch_q(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2], qs)
@@ -241,9 +242,10 @@ def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     st2, tr2 = _transform(kind, shape, cp, eprm, e, ed, X, 2)
     if st2 != 0:
         return st2
-    z = (tr0[0], tr1[0], tr2[0])  # xi = e / rho, or e without an envelope
+    xi = (tr0[0], tr1[0], tr2[0])  # e / rho, or e itself without an envelope (then z = e)
+    z = xi
     if kind != envelopes.NONE:
-        zv = atanh4((z[0], z[1], z[2], 0.0))  # z = atanh(xi), eq. (17)
+        zv = atanh4((xi[0], xi[1], xi[2], 0.0))  # z = atanh(xi), eq. (17)
         z = (zv[0], zv[1], zv[2])
     az = (abs(z[0]), abs(z[1]), abs(z[2]))
     need = (surface_branch(az[0], printed, cp[ZSW], cp[ZFL]) == SURF_POWER,
