@@ -113,10 +113,10 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
               help="Folder for the --all results (default: benchmarks/ of the source tree, else .).")
 def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
     """Time the compiled closed loop; one JSON line per controller with us_per_step."""
-    from .studies.bench import bench_single
+    from .runner.bench import bench_single
 
     if run_all:
-        from .studies.bench import bench_all
+        from .runner.bench import bench_all
 
         doc = bench_all(repeat=repeat, out=Path(bench_out) if bench_out else None, progress=True)
         click.echo(json.dumps(doc, indent=2))
@@ -128,7 +128,7 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
 @cli.command()
 def warmup() -> None:
     """Compile (or load from the cache) every kernel once."""
-    from .studies.bench import warmup as _warmup
+    from .runner.bench import warmup as _warmup
 
     click.echo(json.dumps(_warmup()))
 
@@ -144,8 +144,8 @@ def warmup() -> None:
 def sweep(study: str, out: str | None, workers: int | None, scheduler: str | None, resume: bool,
           max_chunks: int | None, quiet: bool) -> None:
     """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask."""
-    from .studies.sweep import run_sweep
-    from .studies.sweep_schema import load_study
+    from .runner.sweep import run_sweep
+    from .runner.sweep_schema import load_study
 
     if workers is not None and scheduler:
         raise BadInput("--workers and --scheduler exclude each other (the scheduler's cluster has its workers)")

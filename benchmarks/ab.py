@@ -29,8 +29,8 @@ WORKER = r"""
 import json, sys, time
 from auvtrack.scenario import load_scenario
 from auvtrack.simulation.api import prepare
-from auvtrack.simulation.batch import run_metrics
-from auvtrack.studies.bench import paper_scenario_path
+from auvtrack.runner.batch import run_metrics
+from auvtrack.scenario import paper_scenario_path
 import auvtrack
 print(json.dumps(auvtrack.__file__), flush=True)
 prep = prepare(load_scenario(paper_scenario_path(), json.loads(sys.argv[1])))

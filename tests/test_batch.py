@@ -8,9 +8,9 @@ import pytest
 
 from auvtrack.scenario import load_scenario
 from auvtrack.simulation.api import prepare, run_prepared
-from auvtrack.simulation.batch import RunSummary, iter_batch, run_batch, run_metrics
+from auvtrack.runner.batch import RunSummary, iter_batch, run_batch, run_metrics
 from auvtrack.simulation.metrics import METRIC_NAMES
-from auvtrack.studies.bench import paper_scenario_path
+from auvtrack.scenario import paper_scenario_path
 
 PAPER = paper_scenario_path()
 

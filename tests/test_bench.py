@@ -4,8 +4,8 @@ import json
 from click.testing import CliRunner
 
 from auvtrack.cli import cli
-from auvtrack.studies.bench import bench_singles
-from auvtrack.studies.sweep_bench import BREAKDOWN, bench_breakdown
+from auvtrack.runner.bench import bench_singles
+from auvtrack.runner.sweep_bench import BREAKDOWN, bench_breakdown
 
 
 def test_bench_singles_reports_each_controller_in_order():
@@ -34,8 +34,8 @@ def test_results_name_the_vector_math_back_end(tmp_path):
     from pathlib import Path
 
     from auvtrack import _vecmath
-    from auvtrack.studies.bench import machine
-    from auvtrack.studies.sweep_bench import write_results
+    from auvtrack.runner.bench import machine
+    from auvtrack.runner.sweep_bench import write_results
 
     m = machine()
     assert m["vector_math"] == _vecmath.BACKEND
@@ -48,7 +48,7 @@ def test_results_name_the_vector_math_back_end(tmp_path):
 
 
 def test_batch_rows_cover_every_controller_and_back_end():
-    from auvtrack.studies.sweep_bench import bench_batch
+    from auvtrack.runner.sweep_bench import bench_batch
 
     rows = bench_batch(repeat=2, runs=3, duration=0.02)
     assert [(r["controller"], r["backend"]) for r in rows] == [

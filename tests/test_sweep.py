@@ -19,9 +19,9 @@ from auvtrack.cli import main
 from auvtrack.scenario import load_scenario
 from auvtrack.simulation.api import prepare, run_prepared
 from auvtrack.simulation.metrics import METRIC_NAMES
-from auvtrack.studies.sweep import chunk_path, read_results, run_sweep
-from auvtrack.studies.sweep_schema import StudyError, load_study
-from auvtrack.studies.sweep_worker import run_chunk
+from auvtrack.runner.sweep import chunk_path, read_results, run_sweep
+from auvtrack.runner.sweep_schema import StudyError, load_study
+from auvtrack.runner.sweep_worker import run_chunk
 
 
 STUDY = """
@@ -64,7 +64,7 @@ def write_study(folder: Path, chunk: int = 16, text: str = STUDY, name: str = "s
 def client():
     from distributed import Client, LocalCluster
 
-    from auvtrack.studies.bench import warmup
+    from auvtrack.runner.bench import warmup
 
     warmup()  # compile once here (or load the cache) so that the workers only load it
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",

@@ -9,6 +9,7 @@ import copy
 import functools
 import os
 import tomllib
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from pydantic import ValidationError
@@ -16,6 +17,19 @@ from pydantic import ValidationError
 from .errors import ScenarioError, one_line, translate
 from .overrides import Override, Segment, apply_overrides, parse_overrides
 from .schema import Scenario
+
+_DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+def paper_scenario_path() -> Path:
+    """Path of the packaged Section 4 scenario (``auvtrack/data/scenarios/paper.toml``).
+
+    Returns
+    -------
+    pathlib.Path
+        The file; an empty scenario means the same thing.
+    """
+    return _DATA / "scenarios" / "paper.toml"
 
 __all__ = ["load_scenario", "read_toml"]
 

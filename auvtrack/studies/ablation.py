@@ -40,7 +40,7 @@ import numpy as np
 from ..scenario import load_scenario
 from ..simulation.api import prepare, run_prepared
 from ..simulation.result import Result
-from .bench import paper_scenario_path
+from ..scenario import paper_scenario_path
 from .registry import StudySpec
 from .report import Report, failure_cause, fmt, write_json
 

@@ -31,7 +31,7 @@ from ..plant.kinematics import attitude, j3_inv, virtual_point
 from ..reference import build_reference
 from ..scenario import Scenario, load_scenario
 from ..simulation.api import prepare, run_prepared, vehicle_arrays
-from .bench import paper_scenario_path
+from ..scenario import paper_scenario_path
 from .registry import StudySpec
 from .report import Report, failure_cause, fmt, write_json
 

@@ -34,7 +34,7 @@ from typing import Callable
 from matplotlib.figure import Figure
 from tqdm.auto import tqdm
 
-from ..simulation.batch import iter_batch
+from ..runner.batch import iter_batch
 from .registry import StudySpec
 from .report import Report, failure_cause, write_json
 

@@ -19,7 +19,7 @@ from ..simulation import plotting
 from ..simulation.api import prepare, run_prepared
 from ..simulation.result import Result
 from ..scenario import load_scenario
-from .bench import paper_scenario_path
+from ..scenario import paper_scenario_path
 
 CONTROLLERS = (("FXTNTSMC", "fxtntsmc"), ("FTSMC", "ftsmc"))
 # the same comparison with both controllers tuned by one procedure (docs/tuning.md)

@@ -13,7 +13,7 @@ seed, so a sample set is a pure function of ``(seed, n)``):
 
 Every controller configuration sees the *same* samples (common random numbers), on every
 vehicle preset of the configuration (``paper`` and ``remus100`` by default).  Runs go through
-:func:`auvtrack.simulation.batch.run_batch` (threads over the ``nogil`` kernel).  The report
+:func:`auvtrack.runner.batch.run_batch` (threads over the ``nogil`` kernel).  The report
 gives, per vehicle and controller, the failure rate with the failures by cause, and the median
 and 95th percentile of the metrics over the runs that did not fail.
 """
@@ -29,7 +29,7 @@ import numpy as np
 
 from ..scenario import load_scenario
 from ..simulation.api import prepare
-from ..simulation.batch import run_batch
+from ..runner.batch import run_batch
 from .registry import StudySpec
 from .report import failure_cause, write_json
 

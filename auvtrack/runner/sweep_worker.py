@@ -1,7 +1,7 @@
 """What a Dask worker runs for ``auvtrack sweep``: one chunk of samples -> one Arrow table.
 
 Everything here is importable on a worker (no jitted function is ever shipped: the worker
-imports :mod:`auvtrack.simulation.batch`, which loads the compiled kernels from its on-disk
+imports :mod:`auvtrack.runner.batch`, which loads the compiled kernels from its on-disk
 cache).  :func:`run_chunk` is pure: its table depends only on the study and the chunk's sample
 indices, so a retried chunk (after a worker died) gives the same rows.
 """
@@ -89,7 +89,7 @@ def run_chunk(spec: StudySpec, chunk: int):
     """
     import pyarrow as pa
 
-    from ..simulation.batch import run_batch
+    from .batch import run_batch
     from ..simulation.metrics import METRIC_NAMES
 
     schema = result_schema(spec)

@@ -1,7 +1,7 @@
 """``auvtrack sweep``: parameter sweeps and Monte Carlo studies on Dask distributed.
 
-The study (:mod:`auvtrack.studies.sweep_schema`) is cut into chunks of ``chunk_size`` samples;
-each chunk is one Dask task (:func:`auvtrack.studies.sweep_worker.run_chunk`) that runs its
+The study (:mod:`auvtrack.runner.sweep_schema`) is cut into chunks of ``chunk_size`` samples;
+each chunk is one Dask task (:func:`auvtrack.runner.sweep_worker.run_chunk`) that runs its
 samples through the batch runner and returns an Arrow table.  The client writes each completed
 chunk as ``chunks/chunk-NNNNNN.parquet`` atomically (temporary file + rename), so
 
@@ -120,7 +120,7 @@ def _client(workers: int | None, scheduler: str | None, memory_limit: str):
 
     if scheduler:
         return Client(scheduler), None
-    from ..simulation.batch import default_workers
+    from .batch import default_workers
 
     n = default_workers() if workers is None else workers
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",

@@ -245,7 +245,7 @@ def _fail(source: str, field: str, text: str) -> StudyError:
 def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
     from ..scenario.loader import _default_at, read_toml
     from ..scenario.overrides import apply_overrides, parse_overrides
-    from .bench import paper_scenario_path
+    from ..scenario import paper_scenario_path
 
     path = paper_scenario_path() if study.scenario == PAPER_SCENARIO else (folder / study.scenario)
     try:

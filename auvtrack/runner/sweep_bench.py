@@ -39,7 +39,7 @@ def _load() -> float | None:
 def _preps(kind: str, n: int, duration: float) -> list:
     from ..scenario import load_scenario
     from ..simulation.api import prepare
-    from .bench import paper_scenario_path
+    from ..scenario import paper_scenario_path
 
     return [prepare(load_scenario(paper_scenario_path(), {"controller.kind": kind, "sim.duration": duration,
                                                           "seed": i, "uncertainty.D": 0.005 * i}))
@@ -63,8 +63,8 @@ def bench_breakdown(*, repeat: int = 7, duration: float = 5.0) -> list[dict]:
     """Where the time of one RK4 step goes: CPU µs per step of Section 4 variants (metrics only)."""
     from ..scenario import load_scenario
     from ..simulation.api import prepare
-    from ..simulation.batch import run_metrics
-    from .bench import paper_scenario_path
+    from .batch import run_metrics
+    from ..scenario import paper_scenario_path
 
     preps = [prepare(load_scenario(paper_scenario_path(), {"sim.duration": duration, **ov})) for _, ov in BREAKDOWN]
     for prep in preps:
@@ -86,7 +86,7 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
     Also reports the Python-side preparation time per run (scenario validation and packing),
     which is not parallelised by the thread back ends.
     """
-    from ..simulation.batch import default_workers, run_batch
+    from .batch import default_workers, run_batch
 
     kinds, backends = ("ftsmc", "fxtntsmc"), ("serial", "threads", "prange")
     preps, prep_ms = {}, {}

@@ -8,12 +8,9 @@ import time
 from pathlib import Path
 
 
-PAPER = Path(__file__).resolve().parents[1] / "data" / "scenarios" / "paper.toml"
+from ..scenario import paper_scenario_path
 
-
-def paper_scenario_path() -> Path:
-    """Path of the packaged Section 4 scenario."""
-    return PAPER
+PAPER = paper_scenario_path()
 
 
 def machine() -> dict:
@@ -96,7 +93,7 @@ def warmup() -> dict:
     """
     from ..control import CONTROLLERS
     from ..simulation.api import run_prepared
-    from ..simulation.batch import run_batch
+    from .batch import run_batch
 
     out = {}
     preps = []
@@ -118,7 +115,7 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
 
     Single-run µs per RK4 step for every controller, batch runs/s (10 s runs at dt = 1 ms) per
     back end, and sweep throughput on 1 and 2 Dask workers (see
-    :mod:`auvtrack.studies.sweep_bench`).  ``out`` defaults to the source tree's ``benchmarks/``
+    :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to the source tree's ``benchmarks/``
     when it exists, else the current folder.
     """
     from .sweep_bench import bench_batch, bench_breakdown, bench_sweep, write_results
@@ -142,4 +139,4 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     return doc
 
 
-__all__ = ["bench_single", "bench_singles", "bench_all", "warmup", "machine", "paper_scenario_path"]
+__all__ = ["bench_single", "bench_singles", "bench_all", "warmup", "machine"]
