@@ -187,6 +187,7 @@ class Probe:
     survived: bool
     cause: str | None = None
     time: float | None = None
+    max_theta_deg: float | None = None  # largest |pitch| of the run (deg), when the survival function gives it
 
 
 @dataclass
@@ -250,7 +251,8 @@ def scan_survival(survives: Callable[[float], tuple[bool, str | None, float | No
     Parameters
     ----------
     survives : callable
-        ``survives(a) -> (ok, cause, time)``; ``cause`` and ``time`` describe the failure.
+        ``survives(a) -> (ok, cause, time)`` or ``(ok, cause, time, max_theta_deg)``; ``cause``
+        and ``time`` describe the failure.
     a_min, a_max : float
         Search range, ``0 < a_min <= a_max``.
     per_decade : int, optional
@@ -274,8 +276,8 @@ def scan_survival(survives: Callable[[float], tuple[bool, str | None, float | No
     probes: list[Probe] = []
 
     def probe(a: float) -> Probe:
-        ok, cause, t = survives(a)
-        p = Probe(float(a), bool(ok), None if ok else cause, None if ok else t)
+        ok, cause, t, *extra = survives(a)
+        p = Probe(float(a), bool(ok), None if ok else cause, None if ok else t, *extra[:1])
         probes.append(p)
         return p
 
@@ -411,7 +413,9 @@ def _scan_job(job: tuple[Config, str, str, tuple[float, ...], Settings]) -> dict
 
     def survives(a: float):
         res = _run(_scenario(cfg, condition, st.horizon, tuple(a * x for x in vec), st))
-        return res.ok, failure_cause(res), (res.failure or {}).get("time")
+        th = res.channels["theta"]
+        return (res.ok, failure_cause(res), (res.failure or {}).get("time"),
+                float(np.degrees(np.nanmax(np.abs(th)))) if th.size else None)
 
     sv = scan_survival(survives, st.a_min, st.a_max, per_decade=st.per_decade, rtol=st.rtol)
     return {"config": cfg.label, "condition": condition, "direction": direction, **asdict(sv)}
@@ -446,6 +450,11 @@ def survival_text(r: dict[str, Any]) -> str:
     if r["kind"] == "fails_min":
         return f"< {fmt(r['first_failure'])}"
     return f"{fmt(r['survives_up_to'])} – {fmt(r['first_failure'])}"
+
+
+def pitch_at(r: dict[str, Any], amplitude: float | None) -> float | None:
+    """Largest |pitch| (deg) of the probe of record ``r`` at ``amplitude`` (None if not recorded)."""
+    return next((p.get("max_theta_deg") for p in r["probes"] if p["amplitude"] == amplitude), None)
 
 
 def intervals_text(r: dict[str, Any]) -> str:
@@ -684,10 +693,11 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
                            f"{fmt(r.get('max_widening'), 3)} m)" for r in acts) if acts else "") + ".")
     rep.heading("Survival per configuration (amplitude A in N)")
     rows = [[r["config"], r["condition"], r["direction"], fmt(r["survives_up_to"]), fmt(r["first_failure"]),
-             r["cause"] or "no failure", r["fail_time"], intervals_text(r), "yes" if r["monotone"] else "NO",
-             len(r["probes"])] for r in scans]
+             r["cause"] or "no failure", r["fail_time"], pitch_at(r, r["survives_up_to"]), intervals_text(r),
+             "yes" if r["monotone"] else "NO", len(r["probes"])] for r in scans]
     rep.table(["configuration", "condition", "direction", "survives up to", "first failure", "cause",
-               "failure time (s)", "survival intervals", "monotone", "runs"], rows)
+               "failure time (s)", "max pitch at 'survives up to' (deg)", "survival intervals", "monotone", "runs"],
+              rows)
     rep.figure(_figure(scans, st), "survival",
                "Survival intervals per configuration and direction (green), failing probes as ticks coloured by cause.")
     case, near = _near_threshold(scans, cfgs, st)
