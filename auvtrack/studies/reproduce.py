@@ -207,7 +207,7 @@ def form_verdicts(overrides: list[str], ftsmc: tuple[dict, dict], window: tuple[
 
 def _forms_summary(forms: list[dict]) -> str:
     """Markdown: the verdicts for each form of the law, with conditions and evidence."""
-    lines = ["## The claims under each form of the FXTNTSMC", "",
+    lines = ["", "## The claims under each form of the FXTNTSMC", "",
              "The FTSMC run is the same throughout (default gains); each row changes the FXTNTSMC only as named.", "",
              "| form | " + " | ".join(CLAIMS) + " |", "|---|" + "---|" * len(CLAIMS)]
     for f in forms:

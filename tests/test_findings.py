@@ -1,0 +1,109 @@
+"""docs/findings.md and the README's reproduction section quote only the stored study results.
+
+* Every generated section equals what ``auvtrack.studies.findings`` renders from ``docs/results/``.
+* Outside the generated sections findings.md contains no number except references (ERRATA n,
+  Section n, eq. (n), §n, issue n, REMUS 100, ...): a number typed by hand fails the test.
+* The stored results were produced by the current study definitions (the default settings and
+  the default conditions), so a changed default cannot leave stale numbers behind.
+"""
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import asdict
+
+import pytest
+
+from auvtrack.studies import ablation, findings, fixed_time, robustness
+
+ALLOWED = [
+    r"REMUS 100", r"ERRATA \d+", r"issue \d+", r"§\d+", r"Section \d+", r"Sec\. \d+(\.\d+)?",
+    r"Figures? \d+(–\d+)?", r"Theorem \d+", r"Lemma \d+", r"\(\d+\)", r"^#+ \d+\.",
+]
+
+
+def _outside_blocks(text: str) -> str:
+    return findings.BLOCK_RE.sub(lambda m: "", text)
+
+
+def test_every_generated_block_matches_the_stored_results():
+    for key, path in findings.DOCS.items():
+        text = path.read_text()
+        names = [m.group("name") for m in findings.BLOCK_RE.finditer(text)]
+        want = [n for n, (doc, _) in findings.blocks().items() if doc == key]
+        assert sorted(names) == sorted(want), key  # every block present, once
+        assert findings.render_text(text, key) == text, f"{path.name}: stale; run python -m auvtrack.studies.findings render"
+
+
+def test_findings_has_no_number_outside_the_generated_sections():
+    text = _outside_blocks(findings.DOCS["findings"].read_text())
+    for line in text.splitlines():
+        rest = line
+        for pat in ALLOWED:
+            rest = re.sub(pat, "", rest)
+        assert not re.search(r"\d", rest), f"number typed by hand in docs/findings.md: {line!r}"
+
+
+def test_the_number_check_catches_a_hand_typed_number():
+    """The check above is not vacuous: a typed number outside a block is found."""
+    text = "Prose with ERRATA 14 and §3 only.\nThe pulse survives 930 N.\n"
+    bad = []
+    for line in text.splitlines():
+        rest = line
+        for pat in ALLOWED:
+            rest = re.sub(pat, "", rest)
+        if re.search(r"\d", rest):
+            bad.append(line)
+    assert bad == ["The pulse survives 930 N."]
+
+
+def test_a_changed_result_makes_the_block_stale(monkeypatch):
+    real = findings.load
+
+    def tampered(name):
+        data = real(name)
+        if name == "reproduce":
+            data["full_window"]["FXTNTSMC"]["settle_1cm_x"] *= 1.5
+        return data
+
+    monkeypatch.setattr(findings, "load", tampered)
+    text = findings.DOCS["findings"].read_text()
+    assert findings.render_text(text, "findings") != text
+
+
+def _jsonish(obj):
+    return json.loads(json.dumps(obj))
+
+
+def test_stored_results_come_from_the_current_study_definitions():
+    ab = findings.load("ablation")
+    assert ab["settings"] == _jsonish({**asdict(ablation.Settings()), "horizon": ablation.Settings().horizon})
+    s40 = findings.load("ablation-surge40")
+    want = ablation.settings_for(pulse="1,0,0,0.25,0.25", pulse_start=40.0)
+    assert s40["settings"] == _jsonish({**asdict(want), "horizon": want.horizon})
+    ft = findings.load("fixed-time")
+    assert ft["settings"] == _jsonish(asdict(fixed_time.Settings()))
+    assert ft["estimator"] == findings.DEFAULT_EST
+    rb = findings.load("robustness")
+    assert rb["config"] == _jsonish(asdict(robustness.FULL)) and rb["quick"] is False
+    rl = findings.load("realism")
+    assert rl["duration_s"] == 40.0
+    rp = findings.load("reproduce")
+    from auvtrack.scenario import load_scenario, paper_scenario_path
+    from auvtrack.studies.reproduce import FORMS, conditions
+
+    sc = load_scenario(paper_scenario_path())
+    assert sc.estimator.kind == findings.DEFAULT_EST
+    cond = conditions(sc, notes=("rho_bar_y(0) widened",))
+    assert rp["conditions"] == cond
+    assert [f["name"] for f in rp["forms"]] == [f[0] for f in FORMS]
+    assert rp["steady_window"]["window"] == [50.0, 100.0]  # the full run, not --quick
+    for name in findings.SOURCES:
+        assert findings.load(name)["_provenance"]["command"] == findings.SOURCES[name]
+
+
+@pytest.mark.parametrize("name", sorted(findings.SOURCES))
+def test_stored_results_are_strict_json(name):
+    text = (findings.RESULTS / f"{name}.json").read_text()
+    assert "NaN" not in text and "Infinity" not in text
+    json.loads(text)
