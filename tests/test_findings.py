@@ -107,3 +107,48 @@ def test_stored_results_are_strict_json(name):
     text = (findings.RESULTS / f"{name}.json").read_text()
     assert "NaN" not in text and "Infinity" not in text
     json.loads(text)
+
+
+def test_the_prose_of_findings_md_holds_on_the_stored_results():
+    """The sentences outside the generated sections read the data; each reading is checked here."""
+    from auvtrack.studies.ablation import compare, config_label
+
+    ab = findings.load("ablation")
+    assert findings._direction_matters(ab)  # "the verdict differs between" directions
+    est = findings.DEFAULT_EST
+    for cond in ab["settings"]["conditions"]:
+        none = findings._scan(ab, config_label("none", est), cond, "sway")
+        for env in ("rigid", "reactive", "proactive"):
+            r = findings._scan(ab, config_label(env, est), cond, "sway")
+            assert compare(none, r) == 1  # sideways: no envelope survives more than any envelope
+            assert r["first_failure"] < none["survives_up_to"] and not r["monotone"]  # a shared pitch window
+            assert r["cause"] == "pitch_limit"
+        for d, _ in ab["settings"]["directions"]:  # proactive vs rigid: helps or ties, never worse
+            assert compare(findings._scan(ab, config_label("proactive", est), cond, d),
+                           findings._scan(ab, config_label("rigid", est), cond, d)) >= 0
+    none = findings._scan(ab, config_label("none", est), "continuous", "surge+moments")
+    for env in ("rigid", "reactive", "proactive"):  # surge + moments: the envelopes survive larger pulses
+        r = findings._scan(ab, config_label(env, est), "continuous", "surge+moments")
+        assert compare(r, none) == 1 and r["survives_up_to"] > 2 * none["first_failure"]  # "several times"
+    rp = findings.load("reproduce")
+    forms = {f["name"]: f for f in rp["forms"]}
+    acc = {n: findings._verdicts(f["verdicts"])["higher accuracy"] for n, f in forms.items()}
+    assert acc["corrected"] == "supported" and acc["printed_law34"] == "not supported"  # (34) changes it
+    assert acc["printed_surface28"] == acc["corrected"]
+    assert forms["omega"]["full_window"] == forms["corrected"]["full_window"]  # coincide in Section 4
+    for f in forms.values():  # "far below a millimetre in steady state, whichever form"
+        if f["status"] == "ok":
+            assert max(f["steady_window"][f"rmse_{a}"] for a in "xyz") < 1e-4
+    ft = findings.load("fixed-time")
+    assert ft["verdict"]["verdict"] == "not demonstrated" and findings._ft_facts(ft)["flat_by_estimator"]
+    rl = findings.load("realism")
+    for veh in ("paper", "remus100"):
+        mine = [r for r in rl["rows"] if r["vehicle"] == veh]
+        fx = [r for r in mine if r["controller"] == "fxtntsmc" and r["status"] != "ok"]
+        fts = [r for r in mine if r["controller"] == "ftsmc" and r["status"] != "ok"]
+        assert len(fts) < len(fx)  # the FTSMC is the more robust in a digital loop
+        assert sum(r["cause"] == "envelope_violation" for r in fx) > len(fx) / 2  # "mostly envelope violations"
+        for lv in {r["level"] for r in mine if r["factor"] == "current"}:  # better against currents
+            a = next(r for r in mine if r["factor"] == "current" and r["level"] == lv and r["controller"] == "fxtntsmc")
+            b = next(r for r in mine if r["factor"] == "current" and r["level"] == lv and r["controller"] == "ftsmc")
+            assert a["status"] == "ok" and (b["status"] != "ok" or a["rmse"] < b["rmse"])

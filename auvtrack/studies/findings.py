@@ -26,6 +26,7 @@ import sys
 from pathlib import Path
 from typing import Any, Callable
 
+from .fixed_time import LABELS
 from .report import fmt
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -147,8 +148,8 @@ def block_reproduce(rp: dict) -> str:
         f"{_axes(b, 'settle_1cm', d=3)} | {v['faster convergence']} |",
         f"| higher accuracy | steady RMSE on [{_f(w[0])}, {_f(w[1])}] s, x / y / z (m) | {_axes(sa, 'rmse')} | "
         f"{_axes(sb, 'rmse')} | {v['higher accuracy']} |",
-        f"| less chattering | TV of τ per s on [{_f(w[0])}, {_f(w[1])}] s, u / q / r | {_axes(sa, 'tv_tau', INPUTS)} | "
-        f"{_axes(sb, 'tv_tau', INPUTS)} | {v['less chattering']} |", "",
+        f"| less chattering | TV of τ per s on [{_f(w[0])}, {_f(w[1])}] s, u / q / r | {_axes(sa, 'tv_tau', INPUTS, 3)} | "
+        f"{_axes(sb, 'tv_tau', INPUTS, 3)} | {v['less chattering']} |", "",
         f"Largest input: max |τ_u| {_f(a['max_abs_tau_u'])} N (FXTNTSMC) vs {_f(b['max_abs_tau_u'])} N (FTSMC).", "",
         "**The same claims under each form of the FXTNTSMC** (the FTSMC run unchanged; each row changes only "
         "what it names):", "",
@@ -266,7 +267,7 @@ def _surge40(s40: dict) -> str:
         cells.append(f"{_label(config_label(env, DEFAULT_EST))}: {_surv(r)}")
     ft = _scan(s40, "ftsmc", "continuous", d)
     cells.append(f"FTSMC: {_surv(ft)}")
-    return (f"**The audit's case** ({d}, onset {_f(st['pulse_start'])} s, continuous control, "
+    return (f"**Surge force with moments, later onset** ({d}, onset {_f(st['pulse_start'])} s, continuous control, "
             f"`auvtrack study ablation --pulse {','.join(f'{x:g}' for x in vec)} --pulse-start {st['pulse_start']:g}`): "
             + "; ".join(cells) + ".")
 
@@ -318,7 +319,8 @@ def block_realism(rl: dict) -> str:
             for lv in dict.fromkeys(r["level"] for r in mine if r["factor"] == fac):
                 cell = {k: next((r for r in mine if r["factor"] == fac and r["level"] == lv and r["controller"] == k),
                                 None) for k in ("fxtntsmc", "ftsmc")}
-                lines.append(f"| {lab} | {_f(lv)}" + (f" {unit}" if fac != "ideal" and unit not in ("-", "") else "")
+                level = "–" if fac == "ideal" else _f(lv) + ("" if unit in ("-", "") else f" {unit}")
+                lines.append(f"| {lab} | {level}"
                              + f" | {_realism_cell(cell['fxtntsmc'])} | {_realism_cell(cell['ftsmc'])} |")
         fails = {k: sum(1 for r in mine if r["controller"] == k and r["status"] != "ok") for k in ("fxtntsmc", "ftsmc")}
         n = {k: sum(1 for r in mine if r["controller"] == k) for k in ("fxtntsmc", "ftsmc")}
@@ -328,13 +330,18 @@ def block_realism(rl: dict) -> str:
 
 
 def _realism_failures(rl: dict, vehicle: str, kind: str) -> list[str]:
+    """The failing levels of one controller, grouped by factor: ``control rate 200, 100 Hz``."""
     from .realism import FACTORS
 
-    lab = {f.name: f.label for f in FACTORS}
-    out = []
+    lab = {f.name: (f.label, f.unit) for f in FACTORS}
+    groups: dict[str, list[str]] = {}
     for r in rl["rows"]:
         if r["vehicle"] == vehicle and r["controller"] == kind and r["status"] != "ok":
-            out.append(f"{lab.get(r['factor'], r['factor'])} {_f(r['level'])}")
+            groups.setdefault(r["factor"], []).append(_f(r["level"]))
+    out = []
+    for fac, levels in groups.items():
+        name, unit = lab.get(fac, (fac, "-"))
+        out.append(f"{name} {', '.join(levels)}" + ("" if unit in ("-", "") else f" {unit}"))
     return out
 
 
@@ -347,6 +354,20 @@ def _ft_facts(ft: dict) -> dict[str, Any]:
     return {"smallest_failed": min(failing) if failing else None,
             "causes": ", ".join(c.replace("_", " ") for c in causes) or "none",
             "flat_by_estimator": any(s.startswith("That the flat curve") for s in vd["not_shown"])}
+
+
+def _direction_matters(ab: dict) -> bool:
+    """True when no envelope beats the envelopes in one direction and loses to them in another."""
+    signs = set()
+    for d, _ in ab["settings"]["directions"]:
+        tl = _direction_tally(ab, d)
+        nv = [tl.get(f"none_vs_{e}", [0, 0, 0]) for e in ("rigid", "reactive", "proactive")]
+        larger, smaller = sum(x[0] for x in nv), sum(x[2] for x in nv)
+        if larger > smaller:
+            signs.add(1)
+        elif smaller > larger:
+            signs.add(-1)
+    return signs == {1, -1}
 
 
 def block_summary(rp: dict, ab: dict, s40: dict, ft: dict, rb: dict, rl: dict) -> str:
@@ -372,7 +393,7 @@ def block_summary(rp: dict, ab: dict, s40: dict, ft: dict, rb: dict, rl: dict) -
     items.append(
         f"**Fixed-time convergence: {vd['verdict']}.** Theorem 1's bound is T ≥ {_f(b['T'])} s for the paper's gains "
         f"(vacuous: {'yes' if b['vacuous'] else 'no'}); the measured log-log slope of the time to 1 cm against |e(0)| "
-        "is " + ", ".join(f"{_f(sl[k], 2)} ({k})" for k in sl) + f" (start `{vd['start']}`)"
+        "is " + ", ".join(f"{_f(sl[k], 2)} ({LABELS.get(k, k)})" for k in sl) + f" (start `{vd['start']}`)"
         + ("; the nearly flat curve of the default FXTNTSMC comes from the estimator's random initial weights"
            if fa["flat_by_estimator"] else "")
         + (f"; runs from |e(0)| = {_f(fa['smallest_failed'])} m fail ({fa['causes']}) before they can be timed."
@@ -389,10 +410,11 @@ def block_summary(rp: dict, ab: dict, s40: dict, ft: dict, rb: dict, rl: dict) -
         parts.append(f"{d}: no envelope survives a larger first-transition pulse than an envelope in {larger} of "
                      f"{3 * n} comparisons and a smaller one in {smaller}")
     items.append("**Flexible envelope** (`auvtrack study ablation`, default estimator, continuous and 500 Hz "
-                 "control; the direction matters): " + "; ".join(parts) + ".  " + _surge40(s40))
+                 "control" + ("; the direction matters" if _direction_matters(ab) else "") + "): "
+                 + "; ".join(parts) + ".  " + _surge40(s40))
     fx, fts = _realism_failures(rl, "paper", "fxtntsmc"), _realism_failures(rl, "paper", "ftsmc")
     items.append("**Away from the ideal loop** (`auvtrack study realism`, paper vehicle, one factor at a time): "
-                 f"the FXTNTSMC fails at {', '.join(fx) or 'no level'}; the FTSMC at {', '.join(fts) or 'no level'}.")
+                 f"the FXTNTSMC fails at {'; '.join(fx) or 'no level'}; the FTSMC at {'; '.join(fts) or 'no level'}.")
     per = rb["summary"].get("paper", {})
     items.append("**Monte Carlo** (`auvtrack study robustness`, paper vehicle): failed runs " + ", ".join(
         f"{lab} {s['failed']} of {s['n']}" for lab, s in per.items()) + ".")
@@ -428,7 +450,7 @@ def block_readme(rp: dict, ab: dict, ft: dict, rl: dict) -> str:
         f"[{_f(w[0])}, {_f(w[1])}] s, max over axes: {_f(max(sa[f'rmse_{x}'] for x in AXES), 2)} m vs "
         f"{_f(max(sb[f'rmse_{x}'] for x in AXES), 2)} m (law (34): {_f(rm34, 2)} m) |",
         f"| less chattering | {v['less chattering']} | {p34v.get('less chattering', '–')} | TV of τ per s on "
-        f"[{_f(w[0])}, {_f(w[1])}] s (u / q / r): {_axes(sa, 'tv_tau', INPUTS)} vs {_axes(sb, 'tv_tau', INPUTS)} |",
+        f"[{_f(w[0])}, {_f(w[1])}] s (u / q / r): {_axes(sa, 'tv_tau', INPUTS, 3)} vs {_axes(sb, 'tv_tau', INPUTS, 3)} |",
         "",
         "With the printed surface (28), baseline (24) or start, and with tuned gains: `reproduce/summary.md` and "
         "[docs/findings.md](docs/findings.md) §1.  The studies:", ""]
@@ -445,12 +467,14 @@ def block_readme(rp: dict, ab: dict, ft: dict, rl: dict) -> str:
         nv = [tl.get(f"none_vs_{e}", [0, 0, 0]) for e in ("rigid", "reactive", "proactive")]
         if sum(nv[0]):
             parts.append(f"{d} {sum(x[0] for x in nv)}/{sum(x[1] for x in nv)}/{sum(x[2] for x in nv)}")
-    lines.append("* **flexible envelope — depends on the direction**: no envelope against an envelope, larger / equal "
+    lines.append("* **flexible envelope"
+                 + (" — depends on the direction**" if _direction_matters(ab) else "**")
+                 + ": no envelope against an envelope, larger / equal "
                  "/ smaller survivable pulse (first transition, default estimator): " + ", ".join(parts)
                  + ".  Survival is not monotone in the amplitude; docs/findings.md §3 has every interval.")
     fx, fts = _realism_failures(rl, "paper", "fxtntsmc"), _realism_failures(rl, "paper", "ftsmc")
-    lines.append(f"* **realism** (paper vehicle, one factor at a time): the FXTNTSMC fails at {', '.join(fx) or 'no level'};"
-                 f" the FTSMC at {', '.join(fts) or 'no level'}.")
+    lines.append(f"* **realism** (paper vehicle, one factor at a time): the FXTNTSMC fails at {'; '.join(fx) or 'no level'};"
+                 f" the FTSMC at {'; '.join(fts) or 'no level'}.")
     return "\n".join(lines)
 
 
