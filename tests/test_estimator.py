@@ -26,7 +26,7 @@ from auvtrack.scenario import load_scenario
 from auvtrack.simulation.api import prepare
 
 sys.path.insert(0, str(Path(__file__).parent))
-from law_points import N_POINTS, _evaluate, _states  # noqa: E402
+from law_points import N_POINTS, NXP, _evaluate, _states  # noqa: E402
 
 PAPER = "scenarios/paper.toml"
 GAINS = (0.005, 0.8, 0.6)  # kappa1, kappa2, kappa3 of Section 4
@@ -90,9 +90,8 @@ def _law_at_states(kind: str):
     sc = load_scenario(PAPER, [f"estimator.kind={kind}"])
     prep = prepare(sc)
     ts, Xs = _states(sc, prep)
-    nx = prep.X0.size
     status = np.zeros(N_POINTS, dtype=np.int64)
-    taus, dXs = np.zeros((N_POINTS, 3)), np.zeros((N_POINTS, nx))
+    taus, dXs = np.zeros((N_POINTS, 3)), np.zeros((N_POINTS, prep.controller.x0.size))  # d/dt of xc
     auxs = np.zeros((N_POINTS, len(fxtntsmc.AUX_NAMES)))
     atts = np.stack([np.cos(Xs[:, 3]), np.sin(Xs[:, 3]), np.cos(Xs[:, 4]), np.sin(Xs[:, 4])], axis=1)
     _evaluate(ts, Xs, atts, prep.cp, prep.vp_nom, prep.ref_p, status, taus, dXs, auxs)
@@ -122,12 +121,12 @@ def test_weight_derivative_is_the_formula_of_each_law(kind):
         e, ed = _errors(prep, ts[n], Xs[n])
         x = np.concatenate([e, ed])
         psi = np.exp(-np.sum((x - centres) ** 2, axis=1) / (2 * b * b))
-        W = Xs[n, fxtntsmc.XC + 3:fxtntsmc.XC + 3 + 3 * m].reshape(3, m)
-        dW = dXs[n, fxtntsmc.XC + 3:fxtntsmc.XC + 3 + 3 * m].reshape(3, m)
+        W = Xs[n, NXP + fxtntsmc.WEIGHTS:NXP + fxtntsmc.WEIGHTS + 3 * m].reshape(3, m)
+        dW = dXs[n, fxtntsmc.WEIGHTS:fxtntsmc.WEIGHTS + 3 * m].reshape(3, m)
         for i, a in enumerate("xyz"):
             S, rho = auxs[n, col[f"S_{a}"]], auxs[n, col[f"rho_{a}"]]
             omega = rho / (rho * rho - e[i] * e[i])
-            _, tr = envelopes.axis_transform(envelopes.PROACTIVE, ts[n], e[i], ed[i], Xs[n, fxtntsmc.XC + i],
+            _, tr = envelopes.axis_transform(envelopes.PROACTIVE, ts[n], e[i], ed[i], Xs[n, NXP + fxtntsmc.RHO_BAR + i],
                                              eprm, fxtntsmc.EP0, i)
             G = tr[2] - tr[6]
             assert tr[2] == pytest.approx(omega, rel=1e-12)
