@@ -525,6 +525,34 @@ def _near_threshold(scans: list[dict[str, Any]], cfgs: list[Config], st: Setting
     return None, []
 
 
+def _band_gain_job(job: tuple[Config, str, str, tuple[float, ...], float, Settings]) -> dict[str, Any]:
+    cfg, condition, direction, vec, amp, st = job
+    res = _run(_scenario(cfg, condition, st.horizon, tuple(amp * x for x in vec), st, log_dt=0.001))
+    return {"config": cfg.label, "condition": condition, "direction": direction, "amplitude": amp,
+            "status": res.status, "cause": failure_cause(res), "max_g": _summary(res, st.pulse_start).get("max_g"),
+            "band_gain_ratio": band_gain_ratio(res, st.pulse_start)}
+
+
+def band_gain(scans: list[dict[str, Any]], cfgs: list[Config], st: Settings, progress: bool = False) -> list[dict]:
+    """G/Omega inside the risk monitor's band, where the monitor acts most.
+
+    For every (direction, condition), the proactive envelope with the ``omega`` and the default
+    (``effective``) law is run at the largest amplitude the default configuration survived, logged
+    at every step, and :func:`band_gain_ratio` is taken after the pulse onset.
+    """
+    labels = [config_label("proactive", DEFAULT_ESTIMATOR), config_label("proactive", "omega")]
+    chosen = [c for c in cfgs if c.label in labels]
+    jobs = []
+    for d, vec in st.directions:
+        for c in st.conditions:
+            ref = next((r for r in scans if r["config"] == labels[0] and r["condition"] == c and r["direction"] == d),
+                       None)
+            if ref is None or ref["largest_survived"] is None:
+                continue
+            jobs += [(cf, c, d, vec, ref["largest_survived"], st) for cf in chosen]
+    return _pool_map(_band_gain_job, jobs, progress, "band gain") if jobs else []
+
+
 def _near_figure(case: dict[str, Any], runs: list[tuple[str, Result]], st: Settings):
     from matplotlib.figure import Figure
 
@@ -722,6 +750,18 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
                             "law there.")
         rep.figure(_near_figure(case, near, st), "near_threshold",
                    "What each envelope scheme does at the pulse that breaks the rigid envelope.")
+    bands = band_gain(scans, cfgs, st, progress)
+    if bands:
+        rep.heading("Effective gain inside the risk monitor's band")
+        rep.paragraph("G/Omega = 1/(1 - 2 c xi^2/rho) (docs/derivation.md section 5) over the samples with 0 < g < 1 "
+                      "after the pulse onset, for the proactive envelope at the largest amplitude the default "
+                      "configuration survived, logged at every step.  The `omega` law adapts Omega/G times faster "
+                      "than the Lyapunov-consistent `effective` law there.")
+        rep.table(["configuration", "condition", "direction", "A (N)", "status", "max g", "band samples",
+                   "G/Omega min", "median", "max"],
+                  [[b["config"], b["condition"], b["direction"], b["amplitude"], b["status"], b["max_g"],
+                    *((b["band_gain_ratio"][k] for k in ("samples", "min", "median", "max")) if b["band_gain_ratio"]
+                      else (0, None, None, None))] for b in bands])
     rep.heading(f"Metrics at the reference amplitude ({st.a_ref:g} N), t >= {st.pulse_start:g} s")
     keys = ("status", "cause", "fail_time", "max_abs_e", "rmse", "max_abs_tau", "energy_tau", "tv_tau", "max_g",
             "max_widening")
@@ -736,7 +776,8 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     rep.paragraph("settle_*: time after which every axis stays within 1 cm / 1 mm (inf: not settled).  "
                   "Every probe of the survival scans (amplitude, outcome, cause, time) is in `results.json`.")
     write_json(out / "results.json", {"study": "ablation", "settings": {**asdict(st), "horizon": st.horizon},
-                                      "tally": tally, "near_threshold": near_info, "nominal": nominal,
+                                      "tally": tally, "near_threshold": near_info, "band_gain": bands,
+                                      "nominal": nominal,
                                       "scans": scans, "reference": reference})
     return rep.write()
 

@@ -249,10 +249,22 @@ def block_ablation(ab: dict, s40: dict) -> str:
                          f"{_label(k)} {v['status']}" + (f" ({v['cause'].replace('_', ' ')} at {_f(v['fail_time'])} s)"
                                                          if v["cause"] else "") for k, v in nt["runs"].items()) + ".")
         if rat:
-            lines.append("Inside the risk monitor's band the effective gain is far below Ω: G/Ω " + "; ".join(
+            lines.append("Inside the risk monitor's band in those runs, G/Ω: " + "; ".join(
                 f"{_label(k)} min {_f(q['min'], 2)}, median {_f(q['median'], 2)}, max {_f(q['max'], 2)} "
-                f"({q['samples']} logged samples)" for k, q in rat.items())
-                + " — the Ω law adapts Ω/G times faster there than the Lyapunov-consistent G law.")
+                f"({q['samples']} logged samples)" for k, q in rat.items()) + ".")
+    bands = [b for b in ab.get("band_gain", []) if b["band_gain_ratio"]]
+    if bands:
+        lines += ["", "**Effective gain inside the risk monitor's band** (proactive envelope at the largest pulse the "
+                      "default configuration survived, every step logged, samples with 0 < g < 1 after the onset): "
+                      "G/Ω is far below one, so the Ω law adapts Ω/G times faster there than the Lyapunov-consistent "
+                      "G law.", "",
+                  "| configuration | direction | condition | A (N) | status | samples | G/Ω min / median / max |",
+                  "|---|---|---|---|---|---|---|"]
+        for b in bands:
+            q = b["band_gain_ratio"]
+            lines.append(f"| {_label(b['config'])} | {b['direction']} | {b['condition']} | {_f(b['amplitude'])} | "
+                         f"{b['status']} | {q['samples']} | {_f(q['min'], 2)} / {_f(q['median'], 2)} / "
+                         f"{_f(q['max'], 2)} |")
     return "\n".join(lines)
 
 
