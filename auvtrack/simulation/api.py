@@ -18,6 +18,7 @@ from ..plant.actuators import pack_actuator
 from ..plant.kinematics import attitude, virtual_point
 from ..plant.presets import get_preset, pack_vehicle
 from ..reference import build_reference
+from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
 from . import engine
 from .metrics import METRICS_SIZE, metrics_finalize, metrics_init
@@ -145,7 +146,8 @@ def prepare(scenario: Scenario) -> Prepared:
     X0 = np.concatenate([eta0, nu0, cc.xc0]).astype(np.float64)
     return Prepared(sc, X0, si, sf, np.ascontiguousarray(cc.cp, dtype=np.float64), vp_nom, vp_true,
                     ref_p, tables.rows, tables.current, noise, n_steps // log_every + 1,
-                    BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS, tuple(cc.notes),
+                    BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS,
+                    tuple(cc.notes) + tuple(n for n in [start_note(ref, eta0, vp_nom[engine.ELL])] if n),
                     {"vehicle": vehicle_record, "controller": cc.resolved})
 
 
