@@ -331,8 +331,10 @@ class Report:
         self.blocks.append(Block("table", {"headers": headers, "rows": cells}))
 
     def markdown(self, text: str) -> None:
-        """Add pre-formatted Markdown (e.g. :func:`metrics_table`): verbatim in the Markdown file,
-        parsed by :func:`markdown_blocks` for the HTML page."""
+        """Add pre-formatted Markdown (e.g. :func:`metrics_table`), verbatim.
+
+        The Markdown file gets it as it is; the HTML page gets it parsed by :func:`markdown_blocks`.
+        """
         self.blocks.append(Block("markdown", {"text": text, "blocks": markdown_blocks(text)}))
 
     def verdicts(self, rows: Iterable[tuple[str, str, str]]) -> None:
@@ -431,7 +433,13 @@ class Report:
         return env.get_template("report.html.j2").render(title=self.title, blocks=[*self.blocks, *self._closing()])
 
     def write(self, name: str = "report.md", html: str | None = "report.html") -> Path:
-        """Write ``<out>/<name>`` (Markdown) and ``<out>/<html>`` (HTML, unless None); return the Markdown path."""
+        """Write ``<out>/<name>`` (Markdown) and ``<out>/<html>`` (HTML, unless None).
+
+        Returns
+        -------
+        pathlib.Path
+            The Markdown file.
+        """
         self.out.mkdir(parents=True, exist_ok=True)
         path = self.out / name
         path.write_text(self.text(), encoding="utf-8")

@@ -18,11 +18,11 @@ from tqdm.auto import tqdm
 
 from ..control.params import get_gain_preset
 from ..simulation import plotting
-from .report import Report
 from ..simulation.api import prepare, run_prepared
 from ..simulation.result import Result
 from ..scenario import load_scenario
 from ..scenario import paper_scenario_path
+from .report import Report
 
 CONTROLLERS = (("FXTNTSMC", "fxtntsmc"), ("FTSMC", "ftsmc"))
 # the same comparison with both controllers tuned by one procedure (docs/tuning.md)
@@ -38,21 +38,21 @@ FIGURES = (
     ("fig8_chi", plotting.fig_chi),
 )
 CAPTIONS = {
-    "fig3_trajectory3d": "Fig. 3: path of the virtual point eta_1 (the point the controllers track, vehicle.l = {ell} "
-                         "ahead of the centre of gravity) against the reference eta_d (dashed); the thin lines are the "
-                         "centres of gravity, which lag the virtual point by design. Hollow markers: each run's start. "
-                         "The z axis points down (NED).",
-    "fig4_positions": "Fig. 4: virtual-point position eta_1 against the reference eta_d (dashed) per axis; thin lines: "
-                      "centre of gravity, offset by vehicle.l = {ell} along the body axis (not a tracking error).",
+    "fig3_trajectory3d": "Fig. 3: path of the virtual point η₁ (the point the controllers track, vehicle.l = {ell} ahead "
+                         "of the centre of gravity) against the reference η_d (dashed); the thin lines are the centres "
+                         "of gravity, which trail the virtual point by design. Hollow markers: each run's start. The "
+                         "z axis points down (NED).",
+    "fig4_positions": "Fig. 4: virtual-point position η₁ against the reference η_d (dashed) per axis; thin lines: "
+                      "centre of gravity, vehicle.l = {ell} behind it along the body axis (not a tracking error).",
     "fig5_velocities": "Fig. 5: body velocities u, v, w and rates q, r.",
     "fig6_inputs": "Fig. 6: control inputs; left the whole run (its scale is set by the start-up spikes), right the "
-                   "steady state t >= {t_ss:g} s on its own scale, where the chattering claim is judged (the same "
-                   "window as the steady-state metrics); the smoother line is drawn on top.",
-    "fig7_errors": "Fig. 7: position errors e = eta_1 - eta_d. Left: with the envelopes +-rho (dash-dot) and the "
-                   "baseline +-rho_1 (dashed), linear as in the paper; right: |e| and the envelopes on a log scale, "
-                   "where the final 5 mm envelope stays visible. Bottom: |e_i|/rho_i (a run fails where it reaches 1) "
-                   "and the flexible part rho_bar = rho - rho_1 of the envelope. The FTSMC has no envelope.",
-    "fig8_chi": "Fig. 8: approximation error chi - chi_hat of the RBF network (FXTNTSMC only; the FTSMC has no estimator).",
+                   "steady state t ≥ {t_ss:g} s on its own scale, where the chattering claim is judged (the window "
+                   "of the steady-state metrics); the smoother line is drawn on top.",
+    "fig7_errors": "Fig. 7: position errors e = η₁ − η_d. Left: with the envelope ±ρ (dash-dot) and the baseline ±ρ₁ "
+                   "(dashed), linear as in the paper; right: |e| and the envelopes on a log scale, where the final "
+                   "envelope stays visible. Bottom: |e_i|/ρ_i (a run fails where it reaches 1) and the flexible part "
+                   "ρ̄ = ρ − ρ₁ of the envelope. The FTSMC has no envelope.",
+    "fig8_chi": "Fig. 8: approximation error χ − χ̂ of the RBF network (FXTNTSMC only; the FTSMC has no estimator).",
 }
 
 
