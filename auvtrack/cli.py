@@ -179,15 +179,17 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
 
 
 @cli.command()
-def warmup() -> None:
-    """Compile every kernel once (or load it from the on-disk cache) and print the seconds each took.
+@click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: every one).")
+@click.option("--plant", "plants", multiple=True, help="Plant model(s) (default: every one).")
+def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
+    """Compile every kernel (each controller on each plant) once, in parallel; later runs load them.
 
     The first command after installing or editing the package compiles the kernels it needs
     (about a minute, more on a loaded machine); warmup does it for every command up front.
     """
     from .runner.bench import warmup as _warmup
 
-    click.echo(json.dumps(_warmup()))
+    click.echo(json.dumps(_warmup(controllers, plants, progress=True)))
 
 
 @cli.command()

@@ -40,20 +40,20 @@ def test_start_on_reference_puts_the_virtual_point_on_eta_d_heading_along_it(spe
     np.testing.assert_allclose(_vp(eta, ell), p, rtol=0, atol=1e-12)
     assert eta[3] == 0.0
     np.testing.assert_allclose([math.cos(eta[4]), math.sin(eta[4])], v[:2] / np.hypot(v[0], v[1]), atol=1e-12)
-    assert start_note(ref, eta, ell) is None
+    assert start_note(ref, _vp(eta, ell), ell) is None
 
 
 def test_section4_start_gets_no_warning_and_a_deep_start_gets_the_fix():
     sc = load_scenario(PAPER)
-    assert start_note(build_reference(dict(sc.reference)), sc.initial.eta, 1.0) is None
+    assert start_note(build_reference(dict(sc.reference)), _vp(sc.initial.eta, 1.0), 1.0) is None
     ref = build_reference({"kind": "lawnmower"})
-    note = start_note(ref, sc.initial.eta, 1.0)
+    note = start_note(ref, _vp(sc.initial.eta, 1.0), 1.0)
     assert note.startswith(NOTE_PREFIX) and "5 m above it" in note and "sim.theta_limit" in note
     fix = [float(x) for x in re.search(r"initial\.eta = \[([^\]]+)\]", note).group(1).split(",")]
     np.testing.assert_allclose(fix, start_on_reference(ref, 1.0), atol=1e-6)
     # the threshold is on the depth offset only: 3 m sideways is Section 4's own start
-    assert start_note(ref, [0.0, 0.0, 5.0 - DEPTH_STEP_WARN + 0.01, 0, 0], 1.0) is None
-    assert start_note(ref, [0.0, 0.0, 5.0 + DEPTH_STEP_WARN + 0.01, 0, 0], 1.0) is not None
+    assert start_note(ref, [3.0, 0.0, 5.0 - DEPTH_STEP_WARN + 0.01], 1.0) is None
+    assert start_note(ref, [0.0, 0.0, 5.0 + DEPTH_STEP_WARN + 0.01], 1.0) is not None
 
 
 @pytest.mark.parametrize("kind", ["fxtntsmc", "ftsmc"])

@@ -49,17 +49,17 @@ def start_on_reference(ref: Reference, ell: float) -> list[float]:
     return [float(p[0] - ell * math.cos(psi)), float(p[1] - ell * math.sin(psi)), float(p[2]), 0.0, psi]
 
 
-def start_note(ref: Reference, eta0, ell: float) -> str | None:
+def start_note(ref: Reference, vp0, ell: float) -> str | None:
     """A warning when the virtual point starts more than :data:`DEPTH_STEP_WARN` off the reference's depth.
 
     Parameters
     ----------
     ref : Reference
         The reference.
-    eta0 : sequence of float
-        ``initial.eta``.
+    vp0 : sequence of float
+        The virtual point eta1 at t = 0 (m, NED), from ``initial.eta`` by paper eq. (2).
     ell : float
-        Virtual-point offset ``vehicle.l`` (m).
+        Virtual-point offset ``vehicle.l`` (m), for the suggested start.
 
     Returns
     -------
@@ -67,8 +67,7 @@ def start_note(ref: Reference, eta0, ell: float) -> str | None:
         One line naming the offset and the ``--set initial.eta=[...]`` that starts on the
         reference, or ``None`` when the start is close enough in depth.
     """
-    x, y, z, th, ps = (float(a) for a in eta0)
-    vp = np.array([x + ell * math.cos(th) * math.cos(ps), y + ell * math.cos(th) * math.sin(ps), z - ell * math.sin(th)])
+    vp = np.asarray(vp0, dtype=float)
     p0 = ref.evaluate(0.0)[0]
     dz = float(vp[2] - p0[2])
     if abs(dz) <= DEPTH_STEP_WARN:
