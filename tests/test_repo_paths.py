@@ -18,7 +18,6 @@ TEXT_SUFFIXES = {".py", ".md", ".toml", ".txt", ".cfg", ".ini", ".json", ".j2", 
 OUTSIDE = re.compile(r"shared/paper|\.\./shared|/work/|ERRATA\.md")
 MD_LINK = re.compile(r"\]\(([^)\s]+)\)")
 RELATIVE = re.compile(r"(?<![\w.])(\.\./[\w./-]+)")
-DOC_MENTION = re.compile(r"(?<![\w/.])(docs/[\w-]+\.md)")
 
 
 def _files() -> list[Path]:
@@ -63,8 +62,6 @@ def test_no_file_refers_outside_the_repository(path):
                 continue
             file = (path.parent / target.split("#")[0]).resolve()
             assert _inside(file) and file.exists(), f"{rel}: link {target} does not resolve inside the repository"
-    for doc in DOC_MENTION.findall(text):
-        assert (ROOT / doc).is_file(), f"{rel} cites {doc}, which does not exist"
 
 
 def test_symlinks_stay_inside_the_repository():
