@@ -48,7 +48,7 @@ def _in_band_residual(res, gain_channel: str) -> tuple[float, int]:
     h = res.t[1] - res.t[0]
     worst, used = 0.0, 0
     for a in "xyz":
-        S, z, g = res[f"S_{a}"], res[f"z_{a}"], res[f"g_{a}"]
+        S, z, g = res[f"sliding_{a}"], res[f"zeta_{a}"], res[f"g_{a}"]
         se = np.array([surface(v, 0.8, 0.8, 0.8, 2.0, False, 0.01, 1e-6)[0] for v in z])
         rhs = -k1 * np.sign(S) - k2 * S**3 - k3 * S + res[f"{gain_channel}_{a}"] * (res[f"chi_{a}"] - res[f"chi_hat_{a}"])
         band = (g > 0) & (g < 1)
@@ -124,7 +124,7 @@ def test_weight_derivative_is_the_formula_of_each_law(kind):
         W = Xs[n, NXP + fxtntsmc.WEIGHTS:NXP + fxtntsmc.WEIGHTS + 3 * m].reshape(3, m)
         dW = dXs[n, fxtntsmc.WEIGHTS:fxtntsmc.WEIGHTS + 3 * m].reshape(3, m)
         for i, a in enumerate("xyz"):
-            S, rho = auxs[n, col[f"S_{a}"]], auxs[n, col[f"rho_{a}"]]
+            S, rho = auxs[n, col[f"sliding_{a}"]], auxs[n, col[f"rho_{a}"]]
             omega = rho / (rho * rho - e[i] * e[i])
             _, tr = envelopes.axis_transform(envelopes.PROACTIVE, ts[n], e[i], ed[i], Xs[n, NXP + fxtntsmc.RHO_BAR + i],
                                              eprm, fxtntsmc.EP0, i)
