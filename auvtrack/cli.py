@@ -1,8 +1,11 @@
 """Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce | study | sweep``.
 
-Bad input (a scenario error, a missing file, an invalid gain) prints ONE line to stderr and
-exits with status 2, never a traceback.  A simulation that fails (divergence, pitch limit,
-envelope violation) keeps and saves its partial result, prints the diagnostic and exits 3.
+Bad input (a scenario error, a missing file, an invalid gain, a run over the plan's limits, an
+output folder that cannot be written) prints ONE line to stderr and exits with status 2, never a
+traceback, and before anything runs.  ``check`` runs exactly the validation of ``run`` (load,
+plan, controller set-up), so it refuses the same scenarios with the same message.  A simulation
+that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
+prints the diagnostic and exits 3.
 """
 from __future__ import annotations
 
@@ -15,6 +18,11 @@ import click
 
 EXIT_BAD_INPUT = 2
 EXIT_SIM_FAILED = 3
+EXIT_INTERRUPTED = 130
+MAX_WORKERS = 256
+EXIT_CODES_HELP = ("Exit status: 0 ok; 2 bad input (one line naming the field, nothing run); "
+                   "3 simulation failed (diagnostic printed, partial result kept); "
+                   "130 interrupted (Ctrl-C; partial result kept).")
 
 
 class BadInput(click.ClickException):
@@ -32,11 +40,25 @@ def _load(scenario: str, overrides: tuple[str, ...]):
     return load_scenario(scenario, list(overrides))
 
 
+def _prepare(scenario: str, sc):
+    """The run's validation after loading: plan and controller set-up (``check`` = ``run`` minus the run)."""
+    from .simulation.api import prepare
+
+    try:
+        return prepare(sc)
+    except ValueError as exc:  # ScenarioError of the plan, or a controller refusing its set-up
+        raise BadInput(f"{scenario}: {_one_line(exc)}") from None
+
+
+def _mib(n: int) -> str:
+    return f"{n / 2 ** 20:.3g} MiB"
+
+
 def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split()) or type(exc).__name__
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(context_settings={"help_option_names": ["-h", "--help"]}, epilog=EXIT_CODES_HELP)
 @click.version_option(package_name="auvtrack")
 def cli() -> None:
     """auvtrack: trajectory-tracking control of underactuated AUVs."""
@@ -46,21 +68,32 @@ set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALU
                           help="Override a scenario key, e.g. --set sim.dt=0.002 (repeatable).")
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("scenario")
-@click.option("--out", type=click.Path(file_okay=False), default=None, help="Run folder (default runs/<name>).")
+@click.option("--out", default=None, metavar="FOLDER",
+              help="Run folder (default runs/<name>); replaced as a whole, and only if it is empty or a run folder.")
 @set_option
 @click.option("--mat", is_flag=True, help="Also write trajectory.mat (MATLAB).")
 def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -> None:
-    """Simulate SCENARIO (a TOML file) and write trajectory.csv and run.json."""
-    from .simulation.api import prepare, run_prepared
+    """Simulate SCENARIO (a TOML file) and write trajectory.csv, run.json and scenario.toml."""
+    from .simulation.api import run_prepared
+    from .simulation.result import FolderError, prepare_run_folder
 
     sc = _load(scenario, overrides)
-    prep = prepare(sc)
+    prep = _prepare(scenario, sc)
+    target = Path(out) if out is not None else Path("runs") / sc.name
+    try:  # before the run: an unwritable folder must not cost the simulation
+        prepare_run_folder(target)
+    except FolderError as exc:
+        raise BadInput(f"{'--out' if out is not None else 'run folder'}: {_one_line(exc)}") from None
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
     res = run_prepared(prep)
-    folder = res.save(Path(out) if out else Path("runs") / sc.name, mat=mat or sc.output.mat)
+    try:
+        folder = res.save(target, mat=mat or sc.output.mat)
+    except FolderError as exc:
+        click.echo(f"auvtrack: error: the run folder could not be written: {_one_line(exc)}", err=True)
+        raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
     if not res.ok:
         f = res.failure
@@ -69,19 +102,26 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         raise click.exceptions.Exit(EXIT_SIM_FAILED)
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("scenario")
 @set_option
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
-    """Validate SCENARIO without running it."""
+    """Validate SCENARIO as run would (load, plan, controller set-up) without simulating it."""
+    from .scenario.plan import plan_run
+
     sc = _load(scenario, overrides)
+    prep = _prepare(scenario, sc)
+    for note in prep.notes:
+        click.echo(f"warning: {note}", err=True)
     if sc.controller.kind == "fxtntsmc":
         from .control.theory import check_theorem1
 
         for v in check_theorem1(sc.controller):
             click.echo(f"warning: {v}", err=True)
+    plan = plan_run(sc, len(prep.channels))
     click.echo(f"ok: {scenario} ({sc.name}: controller {sc.controller.kind}, "
-               f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s)")
+               f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s: {plan.n_steps} steps, {plan.log_rows} logged rows, "
+               f"~{_mib(plan.memory_bytes)})")
 
 
 @cli.command()
@@ -115,6 +155,11 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
     """Time the compiled closed loop; one JSON line per controller with us_per_step."""
     from .runner.bench import bench_single
 
+    if repeat < 1:
+        raise BadInput(f"--repeat: must be >= 1 (a median needs at least one timing) (got {repeat})")
+    if not duration > 0:
+        raise BadInput(f"--duration: must be > 0 s (got {duration:g})")
+
     if run_all:
         from .runner.bench import bench_all
 
@@ -133,26 +178,31 @@ def warmup() -> None:
     click.echo(json.dumps(_warmup()))
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("study")
-@click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default sweeps/<name>).")
+@click.option("--out", default=None, metavar="FOLDER", help="Output folder (default sweeps/<name>).")
 @click.option("--workers", type=int, default=None, help="Worker processes of the local Dask cluster (default: cores).")
+@click.option("--worker-memory", default="1GiB", show_default=True, metavar="SIZE",
+              help="Memory limit of each local worker (e.g. 2GiB); a sample that would not fit is recorded as failed.")
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Use an existing Dask scheduler, tcp://host:port.")
 @click.option("--resume", is_flag=True, help="Finish an interrupted sweep in --out (completed chunks are kept).")
 @click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def sweep(study: str, out: str | None, workers: int | None, scheduler: str | None, resume: bool,
+def sweep(study: str, out: str | None, workers: int | None, worker_memory: str, scheduler: str | None, resume: bool,
           max_chunks: int | None, quiet: bool) -> None:
     """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask."""
-    from .runner.sweep import run_sweep
+    from .runner.sweep import parse_memory, run_sweep
     from .runner.sweep_schema import load_study
 
     if workers is not None and scheduler:
         raise BadInput("--workers and --scheduler exclude each other (the scheduler's cluster has its workers)")
-    if workers is not None and workers < 1:
-        raise BadInput(f"--workers: must be >= 1 (got {workers})")
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise BadInput(f"--workers: must be in [1, {MAX_WORKERS}] (got {workers})")
+    parse_memory(worker_memory)
     spec = load_study(study)
     folder = Path(out) if out else Path("sweeps") / spec.study.name
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        raise BadInput(f"--out: {folder}: is {'a symbolic link' if folder.is_symlink() else 'a file'}, not a folder")
 
     def _stop(signum, frame):  # SIGTERM / SIGINT: stop cleanly (cluster closed, chunks kept for --resume)
         raise KeyboardInterrupt
@@ -162,7 +212,7 @@ def sweep(study: str, out: str | None, workers: int | None, scheduler: str | Non
     handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)}
     try:
         res = run_sweep(spec, folder, workers=workers, scheduler=scheduler, resume=resume, max_chunks=max_chunks,
-                        progress=not quiet)
+                        progress=not quiet, memory_limit=worker_memory)
     finally:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
@@ -224,6 +274,10 @@ def main(argv: list[str] | None = None) -> int:
         rv = cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
     except click.exceptions.Exit as e:
         return e.exit_code
+    except click.UsageError as e:  # one line too, with where to look
+        where = f" (see '{e.ctx.command_path} --help')" if e.ctx is not None else ""
+        click.echo(f"auvtrack: error: {_one_line(e.format_message())}{where}", err=True)
+        return EXIT_BAD_INPUT
     except click.ClickException as e:
         e.show()
         return e.exit_code

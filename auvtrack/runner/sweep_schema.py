@@ -20,9 +20,11 @@ from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
+from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator,
+                      model_validator)
 
 from ..scenario.errors import ScenarioError, format_value, one_line, translate
+from ..scenario.names import check_name
 
 __all__ = ["StudyError", "StudyFile", "StudySpec", "load_study", "PAPER_SCENARIO", "MAX_SAMPLES"]
 
@@ -118,6 +120,11 @@ class StudyFile(_Model):
     common_seeds: Annotated[bool, Strict()] = False
     grid: dict[str, Annotated[list[Any], Field(min_length=1)]] = Field(default_factory=dict)
     random: dict[str, Distribution] = Field(default_factory=dict)
+
+    @field_validator("name")
+    @classmethod
+    def _name(cls, v: str) -> str:
+        return check_name(v)  # it becomes the folder sweeps/<name>: the rule of scenario names
 
     @model_validator(mode="after")
     def _keys(self) -> "StudyFile":
@@ -259,16 +266,29 @@ def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
 
 
 def _probe(spec: StudySpec, field: str, overrides: dict) -> None:
+    """Validate one sample as ``auvtrack check`` would: load, plan and controller set-up."""
+    import warnings
+
     from ..scenario import load_scenario
+    from ..simulation.api import prepare
 
     try:
-        load_scenario(spec.base, overrides)
+        sc = load_scenario(spec.base, overrides)
     except ScenarioError as exc:
         raise _fail(spec.source, field, f"the scenario rejects it: {exc}") from None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            prepare(sc)
+    except ValueError as exc:  # the run plan's limits or the controller's set-up
+        raise _fail(spec.source, field, f"the scenario rejects it: {one_line(str(exc))}") from None
 
 
 def check_against_scenario(spec: StudySpec) -> None:
-    """Validate the base scenario, every grid value and each random range against the scenario schema.
+    """Validate the base scenario, every grid value and each random range as ``auvtrack check`` would.
+
+    Each probe is loaded, planned (``[limits]``) and set up by its controller, so a grid value
+    that ``auvtrack run`` would refuse (``sim.duration = 1e9``) refuses the study up front.
 
     Raises
     ------

@@ -19,6 +19,7 @@ from ..plant.kinematics import attitude, virtual_point
 from ..plant.presets import get_preset, pack_vehicle
 from ..reference import build_reference
 from ..scenario import Scenario, load_scenario
+from ..scenario.plan import plan_run
 from . import engine
 from .metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from .result import Result
@@ -90,13 +91,6 @@ def vehicle_arrays(sc: Scenario) -> tuple[np.ndarray, np.ndarray, dict]:
     return vp_nom, vp_true, record
 
 
-def _steps(value: float, dt: float, name: str) -> int:
-    n = round(value / dt)
-    if n < 1 or abs(n * dt - value) > 1e-9 * max(1.0, value):
-        raise ValueError(f"{name} ({value}) must be a positive integer multiple of sim.dt ({dt})")
-    return n
-
-
 def prepare(scenario: Scenario) -> Prepared:
     """Build every array the compiled engine needs from a validated scenario.
 
@@ -114,13 +108,13 @@ def prepare(scenario: Scenario) -> Prepared:
     ------
     ValueError
         If the controller refuses the set-up (e.g. a start on the envelope with the
-        treatment off), naming the field.
+        treatment off), naming the field, or the run plan exceeds the scenario's ``[limits]``
+        (:class:`~auvtrack.scenario.ScenarioError`, :func:`auvtrack.scenario.plan.plan_run`).
     """
     sc = scenario
     vp_nom, vp_true, vehicle_record = vehicle_arrays(sc)
     ref = build_reference(dict(sc.reference))
     ref_p = ref.pack()
-    tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     eta0 = np.array(sc.initial.eta, dtype=float)
     nu0 = np.array(sc.initial.nu, dtype=float)
     p0, v0, a0 = ref.evaluate(0.0)
@@ -128,10 +122,11 @@ def prepare(scenario: Scenario) -> Prepared:
     p1 = np.array(virtual_point(tuple(eta0), attitude(eta0[3], eta0[4]), vp_nom[engine.ELL]))
     ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed)
     cc = get_controller(sc.controller.kind).setup(sc, ctx)
+    channels = BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS
+    plan = plan_run(sc, len(channels))  # every size checked against [limits] before any allocation
+    tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     dt = sc.sim.dt
-    n_steps = _steps(sc.sim.duration, dt, "sim.duration")
-    log_every = _steps(sc.sim.log_dt, dt, "sim.log_dt")
-    ctrl_every = 0 if sc.sim.control_rate == 0 else _steps(1.0 / sc.sim.control_rate, dt, "1/sim.control_rate")
+    n_steps, log_every, ctrl_every = plan.n_steps, plan.log_every, plan.control_every
     naux = len(cc.aux_names)
     si = np.array([n_steps, log_every, ctrl_every, cc.code, naux, cc.xc0.size], dtype=np.int64)
     t0, t1 = sc.metrics.window
@@ -141,11 +136,10 @@ def prepare(scenario: Scenario) -> Prepared:
     sigma = (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu)
     if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
-    noise = noise_table(sc.seed, n_steps // ctrl_every + 1 if ctrl_every else 1, sigma)
+    noise = noise_table(sc.seed, plan.control_samples if ctrl_every else 1, sigma)
     X0 = np.concatenate([eta0, nu0, cc.xc0]).astype(np.float64)
     return Prepared(sc, X0, si, sf, np.ascontiguousarray(cc.cp, dtype=np.float64), vp_nom, vp_true,
-                    ref_p, tables.rows, tables.current, noise, n_steps // log_every + 1,
-                    BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS, tuple(cc.notes),
+                    ref_p, tables.rows, tables.current, noise, plan.log_rows, channels, tuple(cc.notes),
                     {"vehicle": vehicle_record, "controller": cc.resolved})
 
 
