@@ -67,7 +67,7 @@ def atomic_file(path: str | os.PathLike) -> Iterator[BinaryIO]:
         Binary, write mode.
     """
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name[:64]}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as fh:
             yield fh
@@ -104,9 +104,10 @@ def make_temp_folder(final: Path) -> Path:
     Returns
     -------
     Path
-        ``<parent>/.<name>.tmp-<random>``, with the permissions a plain ``mkdir`` would give.
+        ``<parent>/.<name>.tmp-<random>`` (name cut to 64 characters), with the permissions a
+        plain ``mkdir`` would give.
     """
-    tmp = Path(tempfile.mkdtemp(dir=final.parent, prefix=f".{final.name}.tmp-"))
+    tmp = Path(tempfile.mkdtemp(dir=final.parent, prefix=f".{final.name[:64]}.tmp-"))
     os.chmod(tmp, 0o777 & ~_UMASK)
     return tmp
 
@@ -142,11 +143,16 @@ def publish_folder(tmp: Path, final: Path, replaceable: Callable[[Path], str | N
         reason = replaceable(final)
         if reason is not None:
             raise FolderError(f"{reason}; the complete output is kept in {tmp}")
-        old = final.with_name(f".{final.name}.old-{uuid.uuid4().hex[:12]}")
+        old = final.with_name(f".{final.name[:64]}.old-{uuid.uuid4().hex[:12]}")
         try:
             os.rename(final, old)  # move the previous complete folder aside, atomically
         except FileNotFoundError:
             continue  # another writer moved it first
+        if replaceable(old) is not None:  # it changed between the check and the move: put it back
+            with contextlib.suppress(OSError):
+                os.rename(old, final)
+            raise FolderError(f"{final}: changed while the run was being published; the complete output "
+                              f"is kept in {tmp}")
         shutil.rmtree(old, ignore_errors=True)
     raise FolderError(f"{final}: could not be replaced after {attempts} attempts (other writers); "
                       f"the complete output is kept in {tmp}")

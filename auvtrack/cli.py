@@ -91,8 +91,8 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
     res = run_prepared(prep)
     try:
         folder = res.save(target, mat=mat or sc.output.mat)
-    except FolderError as exc:
-        click.echo(f"auvtrack: error: the run folder could not be written: {_one_line(exc)}", err=True)
+    except OSError as exc:  # FolderError (the folder changed since the check), a full disk...
+        click.echo(f"auvtrack: error: the run folder {target} could not be written: {_one_line(exc)}", err=True)
         raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
     if not res.ok:

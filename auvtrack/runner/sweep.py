@@ -275,11 +275,12 @@ def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: in
     return written, time.perf_counter() - t0
 
 
-def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str):
-    """The table of a finished chunk task; when its worker died, run its samples one by one.
+def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str, attempts: int = 2):
+    """The table of a finished chunk task; when its worker died, run its samples one at a time.
 
-    A sample whose worker dies again is recorded as failed (cause ``worker_died``), so one
-    memory-hungry sample costs its own row, never the sweep.
+    A worker that dies fails every task queued on it, so a sample is blamed only when it kills a
+    worker ``attempts`` times running on its own: it is then recorded as failed (cause
+    ``worker_died``), and one memory-hungry sample costs its own row, never the sweep.
     """
     from distributed import KilledWorker
 
@@ -291,17 +292,20 @@ def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str):
         pass
     import pyarrow as pa
 
-    indices = list(spec.chunk_range(chunk))
-    singles = [client.submit(run_samples, spec, [i], key=f"auvtrack-sample-{token}-{i}", retries=0)
-               for i in indices]
     tables = []
-    for i, f in zip(indices, singles):
-        try:
-            tables.append(f.result())
-        except KilledWorker as exc:
-            tables.append(lost_rows(spec, [i], f"the worker process died running this sample (out of memory?): "
-                                               f"{' '.join(str(exc).split())[:200]}"))
-        f.release()
+    for i in spec.chunk_range(chunk):
+        for attempt in range(attempts):
+            single = client.submit(run_samples, spec, [i], key=f"auvtrack-sample-{token}-{i}-{attempt}", retries=0)
+            try:
+                tables.append(single.result())
+                break
+            except KilledWorker as exc:
+                reason = " ".join(str(exc).split())[:200]
+            finally:
+                single.release()
+        else:
+            tables.append(lost_rows(spec, [i], f"the worker process died running this sample alone, {attempts} times "
+                                               f"(out of memory? see --worker-memory): {reason}"))
     return pa.concat_tables(tables)
 
 

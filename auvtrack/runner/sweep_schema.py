@@ -265,8 +265,8 @@ def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
         raise _fail(source, "set", str(exc)) from None
 
 
-def _probe(spec: StudySpec, field: str, overrides: dict) -> None:
-    """Validate one sample as ``auvtrack check`` would: load, plan and controller set-up."""
+def _problem(spec: StudySpec, overrides: dict) -> ValueError | None:
+    """Validate one sample as ``auvtrack check`` would (load, plan, controller set-up); the error or None."""
     import warnings
 
     from ..scenario import load_scenario
@@ -274,13 +274,26 @@ def _probe(spec: StudySpec, field: str, overrides: dict) -> None:
 
     try:
         sc = load_scenario(spec.base, overrides)
-    except ScenarioError as exc:
-        raise _fail(spec.source, field, f"the scenario rejects it: {exc}") from None
-    try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             prepare(sc)
-    except ValueError as exc:  # the run plan's limits or the controller's set-up
+    except ValueError as exc:  # ScenarioError of the schema or the run plan, a controller refusing its set-up
+        return exc
+    return None
+
+
+def _error_path(exc: ValueError) -> str:
+    """Dotted scenario path an error names (``ScenarioError.path``, else its leading ``a.b: ``)."""
+    path = getattr(exc, "path", "")
+    if path:
+        return path
+    m = re.match(r"^(?:<[^>]*>: )?([A-Za-z_][\w]*(?:\.\w+)*): ", str(exc))
+    return m.group(1) if m else ""
+
+
+def _probe(spec: StudySpec, field: str, overrides: dict) -> None:
+    exc = _problem(spec, overrides)
+    if exc is not None:
         raise _fail(spec.source, field, f"the scenario rejects it: {one_line(str(exc))}") from None
 
 
@@ -298,6 +311,12 @@ def check_against_scenario(spec: StudySpec) -> None:
     study = spec.study
     _probe(spec, "set" if study.set else "scenario", {})
     first = {k: v[0] for k, v in study.grid.items()}
+    exc = _problem(spec, first)
+    if exc is not None:  # the first grid point: blame the grid key the error names
+        path = _error_path(exc)
+        named = [k for k in study.grid if path == k or path.startswith(k + ".") or k.startswith(path + ".")]
+        key = named[0] if named else next(iter(study.grid))
+        raise _fail(spec.source, f"grid.{key}.0", f"the scenario rejects it: {one_line(str(exc))}")
     for key, vals in study.grid.items():
         for j, v in enumerate(vals):
             _probe(spec, f"grid.{key}.{j}", {**first, key: v})
