@@ -20,6 +20,7 @@ EXIT_BAD_INPUT = 2
 EXIT_SIM_FAILED = 3
 EXIT_INTERRUPTED = 130
 MAX_WORKERS = 256
+MAX_REPEAT = 1000
 EXIT_CODES_HELP = ("Exit status: 0 ok; 2 bad input (one line naming the field, nothing run); "
                    "3 simulation failed (diagnostic printed, partial result kept); "
                    "130 interrupted (Ctrl-C; partial result kept).")
@@ -155,8 +156,8 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
     """Time the compiled closed loop; one JSON line per controller with us_per_step."""
     from .runner.bench import bench_single
 
-    if repeat < 1:
-        raise BadInput(f"--repeat: must be >= 1 (a median needs at least one timing) (got {repeat})")
+    if not 1 <= repeat <= MAX_REPEAT:
+        raise BadInput(f"--repeat: must be in [1, {MAX_REPEAT}] (a median needs at least one timing) (got {repeat})")
     if not duration > 0:
         raise BadInput(f"--duration: must be > 0 s (got {duration:g})")
 
