@@ -5,7 +5,9 @@ output folder that cannot be written) prints ONE line to stderr and exits with s
 traceback, and before anything runs.  ``check`` runs exactly the validation of ``run`` (load,
 plan, controller set-up), so it refuses the same scenarios with the same message.  A simulation
 that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
-prints the diagnostic and exits 3.
+prints the diagnostic and exits 3.  Ctrl-C stops a run within about a second, saves what was
+computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps its
+completed chunks for ``--resume`` and exits 130.
 """
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ EXIT_SIM_FAILED = 3
 EXIT_INTERRUPTED = 130
 MAX_WORKERS = 256
 MAX_REPEAT = 1000
+LONG_RUN_STEPS = 1_000_000  # runs this long announce themselves (and that Ctrl-C keeps their result)
 EXIT_CODES_HELP = ("Exit status: 0 ok; 2 bad input (one line naming the field, nothing run); "
                    "3 simulation failed (diagnostic printed, partial result kept); "
                    "130 interrupted (Ctrl-C; partial result kept).")
@@ -77,7 +80,7 @@ set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALU
 @click.option("--mat", is_flag=True, help="Also write trajectory.mat (MATLAB).")
 def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -> None:
     """Simulate SCENARIO (a TOML file) and write trajectory.csv, run.json and scenario.toml."""
-    from .simulation.api import run_prepared
+    from .simulation.api import SimulationInterrupted, ensure_compiled, run_prepared
     from .simulation.result import FolderError, prepare_run_folder
 
     sc = _load(scenario, overrides)
@@ -89,13 +92,23 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         raise BadInput(f"{'--out' if out is not None else 'run folder'}: {_one_line(exc)}") from None
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
-    res = run_prepared(prep)
+    ensure_compiled([prep])  # compile or load the kernel first: Ctrl-C from here on stops the simulation
+    if prep.n_steps >= LONG_RUN_STEPS:
+        click.echo(f"running {prep.n_steps} RK4 steps (Ctrl-C stops the run and keeps its partial result)", err=True)
+    try:
+        res = run_prepared(prep)
+    except SimulationInterrupted as exc:  # stopped within about a second; write what was computed
+        res = exc.result
     try:
         folder = res.save(target, mat=mat or sc.output.mat)
     except OSError as exc:  # FolderError (the folder changed since the check), a full disk...
         click.echo(f"auvtrack: error: the run folder {target} could not be written: {_one_line(exc)}", err=True)
         raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
+    if res.status == "interrupted":
+        click.echo(f"auvtrack: interrupted at t = {res.failure['time']:.6g} s after {res.meta['steps']} of "
+                   f"{prep.n_steps} steps; partial result kept in {folder}", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED)
     if not res.ok:
         f = res.failure
         click.echo(f"auvtrack: simulation failed at t = {f['time']:.6g} s: {f['cause']}: {f['detail']}; "
@@ -212,10 +225,17 @@ def sweep(study: str, out: str | None, workers: int | None, worker_memory: str, 
 
     import signal
 
-    handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)}
+    import threading
+
+    main_thread = threading.current_thread() is threading.main_thread()  # signals are the main thread's
+    handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)} if main_thread else {}
     try:
         res = run_sweep(spec, folder, workers=workers, scheduler=scheduler, resume=resume, max_chunks=max_chunks,
                         progress=not quiet, memory_limit=worker_memory)
+    except KeyboardInterrupt:
+        click.echo(f"auvtrack: sweep interrupted (the cluster is closed, completed chunks are kept); finish with: "
+                   f"auvtrack sweep {study} --out {folder} --resume", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
     finally:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
@@ -284,9 +304,9 @@ def main(argv: list[str] | None = None) -> int:
     except click.ClickException as e:
         e.show()
         return e.exit_code
-    except click.exceptions.Abort:
-        click.echo("auvtrack: aborted", err=True)
-        return 130
+    except click.exceptions.Abort:  # Ctrl-C outside a simulation (loading, compiling, saving)
+        click.echo("auvtrack: interrupted", err=True)
+        return EXIT_INTERRUPTED
     except (ScenarioError, ValueError, KeyError, OSError) as e:
         click.echo(f"auvtrack: error: {_one_line(e)}", err=True)
         return EXIT_BAD_INPUT

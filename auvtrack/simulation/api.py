@@ -256,21 +256,28 @@ def call_kernel(prep: Prepared, out: Outputs) -> tuple[int, int, float]:
 
 
 def _in_worker_thread(fn, stop: np.ndarray):
-    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag."""
+    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag.
+
+    The wait is on an Event, not on ``Thread.join``: a ``join`` interrupted by Ctrl-C can report
+    the thread finished while it still runs (CPython 3.11), and the result would be lost.
+    """
     box: dict[str, Any] = {}
+    done = threading.Event()
 
     def target():
         try:
             box["value"] = fn()
         except BaseException as exc:  # pragma: no cover - re-raised below
             box["error"] = exc
+        finally:
+            done.set()
 
     th = threading.Thread(target=target, name="auvtrack-run", daemon=True)
     th.start()
     interrupted = False
-    while th.is_alive():
+    while not done.is_set():
         try:
-            th.join(0.05)
+            done.wait(0.05)
         except KeyboardInterrupt:
             stop[engine.INFO_STOP] = 1
             interrupted = True
