@@ -131,7 +131,7 @@ def test_the_plan_is_what_prepare_allocates(overrides):
     assert plan.n_steps == round(sc.sim.duration / sc.sim.dt) == prep.si[0]
     assert plan.log_rows == prep.n_rows == round(sc.sim.duration / sc.sim.log_dt) + 1
     assert plan.noise_rows == prep.noise.shape[0]
-    assert sum(plan.current_rows) == (prep.d_cur.shape[0] if plan.current_rows else 0)
+    assert sum(plan.current_rows) == (prep.environment.current.shape[0] if plan.current_rows else 0)
     res = run_prepared(prep)
     assert len(res) == plan.log_rows and res.t[-1] == pytest.approx(sc.sim.duration)  # the log ends at the end
 
