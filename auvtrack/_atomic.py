@@ -8,7 +8,8 @@
 * A folder is written as a whole under a unique temporary name and renamed into place
   (:func:`publish_folder`): the final folder is always absent or one writer's complete output,
   even with concurrent writers.  ``rename(2)`` of a directory onto a non-empty directory fails
-  atomically, which is what makes the swap safe.
+  atomically, which is what makes the swap safe; :func:`publish_new_folder` uses the same
+  failure to give concurrent writers each a folder of their own (``runs/x``, ``runs/x-2``...).
 """
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Iterator
 
 __all__ = ["open_exclusive", "atomic_file", "atomic_write", "make_temp_folder", "publish_folder",
-           "FolderError"]
+           "publish_new_folder", "FolderError"]
 
 _UMASK = os.umask(0o022)
 os.umask(_UMASK)
@@ -110,6 +111,40 @@ def make_temp_folder(final: Path) -> Path:
     tmp = Path(tempfile.mkdtemp(dir=final.parent, prefix=f".{final.name[:64]}.tmp-"))
     os.chmod(tmp, 0o777 & ~_UMASK)
     return tmp
+
+
+def publish_new_folder(tmp: Path, candidates: Iterator[Path], attempts: int = 100_000) -> Path:
+    """Rename the complete folder ``tmp`` to the first of ``candidates`` that is free (absent or empty).
+
+    Concurrent writers each get their own folder: a name taken in the meantime is skipped.
+
+    Parameters
+    ----------
+    tmp : Path
+        The finished folder (from :func:`make_temp_folder`).
+    candidates : iterator of Path
+        Names to try, in order (same file system as ``tmp``).
+    attempts : int, optional
+        Bound on the names tried.
+
+    Returns
+    -------
+    Path
+        The name ``tmp`` now has.
+
+    Raises
+    ------
+    FolderError
+        No free name among the first ``attempts`` (``tmp`` is kept, and named in the message).
+    """
+    for _, final in zip(range(attempts), candidates):
+        try:
+            os.rename(tmp, final)
+            return final
+        except OSError as exc:
+            if exc.errno not in (errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR, errno.EISDIR):
+                raise
+    raise FolderError(f"no free folder name after {attempts} attempts; the complete output is kept in {tmp}")
 
 
 def publish_folder(tmp: Path, final: Path, replaceable: Callable[[Path], str | None],

@@ -93,6 +93,11 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
     for name in ("fig3_trajectory3d", "fig4_positions", "fig5_velocities", "fig6_inputs", "fig7_errors", "fig8_chi"):
         assert (tmp_path / "figures" / f"{name}.png").stat().st_size > 10_000
         assert (tmp_path / "figures" / f"{name}.pdf").exists()
+    from report_check import check_html_report
+
+    html = check_html_report(tmp_path, "summary.md")  # every figure embedded, the same report as summary.md
+    assert html.count('class="verdict ') == 6 and "virtual point" in html  # 3 claims x (paper, tuned gains)
+    assert summary in (tmp_path / "summary.md").read_text()
     m = json.loads((tmp_path / "metrics.json").read_text())
     assert m["status"] == {"FXTNTSMC": "ok", "FTSMC": "ok"}
     assert {v["verdict"] for v in m["verdicts"]} <= {"supported", "not supported", "mixed"}
@@ -109,11 +114,13 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
             assert ctrl[k] == v, (kind, k)
 
 
-def test_help_lists_the_exit_codes(capsys):
-    from auvtrack.cli import EXIT_INTERRUPTED
+def test_subcommand_help_lists_the_exit_codes(capsys):
+    """The top-level --help has its own table (tests/test_cli_help.py); run, check and sweep repeat it."""
+    from auvtrack.cli import EXIT_CODES
 
-    for args in (["--help"], ["run", "--help"], ["check", "--help"], ["sweep", "--help"]):
+    for args in (["run", "--help"], ["check", "--help"], ["sweep", "--help"]):
         assert main(args) == 0
         text = " ".join(capsys.readouterr().out.split())
-        assert "Exit status: 0 ok; 2 bad input" in text and "3 simulation failed" in text
-        assert f"{EXIT_INTERRUPTED} interrupted" in text
+        for code, meaning in EXIT_CODES:
+            assert f"{code} {' '.join(meaning.split())}" in text, (args, code)
+        assert "130 interrupted (Ctrl-C): a run keeps its partial result" in text

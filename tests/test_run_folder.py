@@ -213,3 +213,32 @@ def test_scenario_toml_reproduces_the_trajectory_byte_for_byte(tmp_path, kind, v
     assert (second / "scenario.toml").read_bytes() == (first / "scenario.toml").read_bytes()
     a, b = (json.loads((f / "run.json").read_text()) for f in (first, second))
     assert a["metrics"] == b["metrics"] and a["scenario"] == b["scenario"] and a["failure"] == b["failure"]
+
+
+def test_concurrent_runs_without_out_each_get_their_own_folder(tmp_path, monkeypatch, expected):
+    """The default folders (runs/<name>-<controller>, -2, -3...) are taken when a run is
+    published, so runs started together never overwrite one another."""
+    monkeypatch.chdir(tmp_path)
+    barrier = threading.Barrier(len(DURATIONS))
+    codes: list = []
+
+    def one(d):
+        barrier.wait()
+        codes.append(_quiet_main(["run", str(PAPER), "--set", f"sim.duration={d}"])[0])
+
+    threads = [threading.Thread(target=one, args=(d,)) for d in DURATIONS]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert codes == [0] * len(DURATIONS)
+    folders = sorted(os.listdir(tmp_path / "runs"))
+    assert folders == sorted(["paper-fxtntsmc"] + [f"paper-fxtntsmc-{n}" for n in range(2, len(DURATIONS) + 1)])
+    seen = set()
+    for name in folders:
+        folder = tmp_path / "runs" / name
+        assert verify_run_folder(folder) == []
+        duration = json.loads((folder / "run.json").read_text())["scenario"]["sim"]["duration"]
+        assert (folder / "trajectory.csv").read_bytes() == expected[duration]
+        seen.add(duration)
+    assert seen == set(DURATIONS)

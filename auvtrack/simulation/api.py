@@ -26,6 +26,7 @@ from ..plant.kinematics import attitude, virtual_point
 from ..plant.params import ELL
 from ..plant.presets import vehicle_arrays  # noqa: F401  (re-exported: studies use it from here)
 from ..reference import build_reference
+from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
 from ..scenario.plan import plan_run
 from . import engine, kernels
@@ -206,7 +207,7 @@ def prepare(scenario: Scenario) -> Prepared:
         ref_p=_c(ref_p), settings=Settings(si, sf),
         n_rows=plan.log_rows,
         channels=channels,
-        notes=tuple(cpl.notes) + tuple(cc.notes),
+        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[ELL])] if n),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": cc.resolved},
         statuses={**CONTROLLER_STATUS, **cspec.statuses},

@@ -10,6 +10,7 @@ write to the same folder at once.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import math
 import os
@@ -20,7 +21,8 @@ from typing import Any, BinaryIO, Iterator, Mapping
 
 import numpy as np
 
-from .._atomic import FolderError, make_temp_folder, open_exclusive, publish_folder
+from .._atomic import FolderError, make_temp_folder, open_exclusive, publish_folder, publish_new_folder
+from .channels import current_name, legacy_columns, upgrade_names
 
 BASE_CHANNELS: tuple[str, ...] = ("t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r",
                                   "tau_u", "tau_q", "tau_r", "xd", "yd", "zd", "ex", "ey", "ez")
@@ -256,7 +258,7 @@ class Result:
     channels : mapping of str to array_like
         Equal-length 1-D arrays, insertion-ordered, starting with :data:`BASE_CHANNELS`
         (``t, x, y, z, theta, psi, u, v, w, q, r, tau_u, tau_q, tau_r, xd, yd, zd, ex, ey, ez``),
-        optionally followed by extra channels (``rho_x``, ``chi_hat_x``, ``S_x``...).  Names must
+        optionally followed by extra channels (``rho_x``, ``chi_hat_x``, ``sliding_x``...).  Names must
         be identifiers of at most 63 characters (valid CSV headers and MATLAB variables).
     scenario : mapping
         The resolved scenario (JSON-compatible dict).
@@ -360,15 +362,23 @@ class Result:
         return float(t[-1] - t[0]) if t.size > 1 else 0.0
 
     def __getitem__(self, name: str) -> np.ndarray:
-        """Return channel ``name`` (read-only array)."""
+        """Return channel ``name`` (read-only array); an old channel name warns and still works."""
         try:
             return self._ch[name]
         except KeyError:
+            new = current_name(name, self._ch, self._kind())
+            if new is not None:
+                return self._ch[new]
             raise KeyError(f"no channel {name!r}; available: {', '.join(self._ch)}") from None
 
     def __contains__(self, name: object) -> bool:
-        """Whether a channel called ``name`` exists."""
-        return name in self._ch
+        """Whether a channel called ``name`` exists (old channel names included, see ``channels``)."""
+        return name in self._ch or (isinstance(name, str) and
+                                    current_name(name, self._ch, self._kind(), warn=False) is not None)
+
+    def _kind(self) -> str | None:
+        ctrl = self.scenario.get("controller")
+        return ctrl.get("kind") if isinstance(ctrl, Mapping) else None
 
     def __iter__(self) -> Iterator[str]:
         """Iterate over channel names."""
@@ -396,17 +406,28 @@ class Result:
         return f"Result({', '.join(parts)})"
 
     # ---- conversion
-    def to_pandas(self):
+    def to_pandas(self, legacy_names: bool = True):
         """Return the channels as a :class:`pandas.DataFrame`.
+
+        Parameters
+        ----------
+        legacy_names : bool, optional
+            Also add the renamed channels under their old names (``S_x``, ``z_x`` of the FXTNTSMC,
+            ``s_x`` of the FTSMC), after every channel.  Deprecated: these columns disappear in
+            the next release (:mod:`auvtrack.simulation.channels`); pass ``False`` to drop them now.
 
         Returns
         -------
         pandas.DataFrame
-            One column per channel, in order (``t`` first), one row per sample.
+            One column per channel, in order (``t`` first), one row per sample, then the old
+            names, if any.
         """
         import pandas as pd
 
-        return pd.DataFrame({k: np.array(v) for k, v in self._ch.items()}, columns=list(self._ch))
+        cols = {k: np.array(v) for k, v in self._ch.items()}
+        if legacy_names:
+            cols.update({old: np.array(self._ch[new]) for old, new in legacy_columns(self._ch, self._kind()).items()})
+        return pd.DataFrame(cols, columns=list(cols))
 
     def plot(self, kind: str = "overview", **kw: Any):
         """Draw this result (see :mod:`auvtrack.simulation.plotting`).
@@ -476,7 +497,7 @@ class Result:
                   "(same auvtrack version and machine); see docs/scenarios.md.")
         return dumps(doc, header=header)
 
-    def save(self, out_dir: str | os.PathLike, mat: bool = False) -> Path:
+    def save(self, out_dir: str | os.PathLike, mat: bool = False, *, overwrite: bool = True) -> Path:
         """Write the run folder: ``trajectory.csv``, ``run.json``, ``scenario.toml``, optionally ``trajectory.mat``.
 
         Parameters
@@ -486,11 +507,15 @@ class Result:
             and only if it is empty or holds nothing but run-folder files (:data:`RUN_FILES`).
         mat : bool, optional
             Also write ``trajectory.mat`` (MATLAB v5).
+        overwrite : bool, optional
+            False: never replace a folder; when ``out_dir`` is taken (by the time the run is
+            published), use the first free ``<out_dir>-2``, ``-3``, ... instead (the default run
+            folders of ``auvtrack run``).
 
         Returns
         -------
         pathlib.Path
-            The folder.
+            The folder written (``out_dir``, or a numbered sibling with ``overwrite=False``).
 
         Raises
         ------
@@ -532,6 +557,9 @@ class Result:
         except BaseException:
             shutil.rmtree(tmp, ignore_errors=True)
             raise
+        if not overwrite:
+            return publish_new_folder(tmp, (folder if n == 1 else folder.with_name(f"{folder.name}-{n}")
+                                            for n in itertools.count(1)))
         publish_folder(tmp, folder, run_folder_problem)
         return folder
 
@@ -581,7 +609,8 @@ class Result:
         lines = (folder / CSV_NAME).read_text(encoding="utf-8").splitlines()
         if not lines:
             raise ValueError(f"{folder / CSV_NAME} is empty")
-        names = lines[0].split(",")
+        ctrl = (doc.get("scenario") or {}).get("controller")
+        names = upgrade_names(lines[0].split(","), ctrl.get("kind") if isinstance(ctrl, Mapping) else None)
         if len(lines) > 1:
             data = np.loadtxt(lines[1:], delimiter=",", dtype=np.float64, ndmin=2)
         else:
