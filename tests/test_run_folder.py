@@ -174,7 +174,9 @@ def _below_a_file(p: Path) -> Path:
     (_below_a_file, "cannot write there"),
     (lambda p: p.parent / ("n" * 300), "is longer than"),
     (lambda p: Path(str(p) + "\x00x"), "NUL character"),
-], ids=["file", "foreign-folder", "below-a-file", "too-long", "nul"])
+    (lambda p: p.parent / "empty" / "..", "must name a folder of its own"),
+    (lambda p: Path("/"), "must name a folder of its own"),
+], ids=["file", "foreign-folder", "below-a-file", "too-long", "nul", "dot-dot", "root"])
 def test_a_bad_out_is_refused_before_the_simulation(tmp_path, make, text):
     out = make(tmp_path / "out")
     with mock.patch("auvtrack.simulation.api.run_prepared", side_effect=_Ran):

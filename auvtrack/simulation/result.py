@@ -149,6 +149,8 @@ def run_folder_problem(folder: str | os.PathLike) -> str | None:
     if not text.strip():
         return "the run folder path is empty"
     path = Path(text)
+    if path.name in ("", ".", ".."):
+        return f"{text}: must name a folder of its own (not '.', '..' or '/')"
     limit = _name_max(path.parent)
     long = [p for p in path.parts if len(p.encode("utf-8", "surrogateescape")) > limit]
     if long:
