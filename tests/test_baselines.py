@@ -169,7 +169,7 @@ def test_ppc_transformed_error_obeys_its_design_law_at_any_state(seed):
     """eps_ddot = -kp eps - kd eps_dot (eq. R4) at states spread over the envelope (|xi| up to 0.95)."""
     rng, eta, nu, att, refm, t = _state(seed)
     cc = _setup(ppc, ["controller.kp=3.0", "controller.kd=2.5", "controller.l=0.4"])
-    rho = np.array([ppc.envelope(t, r0, ri, 0.4) for r0, ri in zip((5.0, 1.0, 0.2), (0.005,) * 3)])
+    rho = np.array([ppc.envelope(t, r0, ri, 0.4) for r0, ri in zip(ppc.Params().rho0, (0.005,) * 3)])
     xi = rng.uniform(-0.95, 0.95, 3)
     refm[0] = np.array(virtual_point(eta, att, VP[ELL])) - xi * rho[:, 0]  # e = xi rho
     status, tau, _, aux = _call(ppc, cc, t, eta, nu, att, np.zeros(0), refm)
@@ -183,7 +183,7 @@ def test_ppc_transformed_error_obeys_its_design_law_at_any_state(seed):
 def test_ppc_reports_an_error_on_its_envelope():
     _, eta, nu, att, refm, _ = _state(1)
     cc = _setup(ppc)
-    refm[0] = np.array(virtual_point(eta, att, VP[ELL])) - (0.0, 1.0, 0.0)  # e_y = rho0_y at t = 0
+    refm[0] = np.array(virtual_point(eta, att, VP[ELL])) - (0.0, ppc.Params().rho0[1], 0.0)  # e_y = rho0_y, t = 0
     assert _call(ppc, cc, 0.0, eta, nu, att, np.zeros(0), refm)[0] == 1
     assert ppc.STATUS[1].startswith("envelope violated")
 
@@ -319,7 +319,7 @@ def test_ppc_transformed_error_obeys_its_linear_dynamics_on_the_nominal_plant():
     assert res.ok
     e0, ed0 = _initial_errors(res)
     A = np.array([[0.0, 1.0], [-kp, -kd]])
-    for i, (a, r0) in enumerate(zip("xyz", (5.0, 1.0, 0.2))):
+    for i, (a, r0) in enumerate(zip("xyz", ppc.Params().rho0)):
         rho, rhod, _ = ppc.envelope(0.0, r0, 0.005, lrate)
         eps0 = math.atanh(e0[i] / rho)
         epsd0 = (rho * ed0[i] - rhod * e0[i]) / (rho**2 - e0[i] ** 2)
@@ -377,7 +377,7 @@ def test_a_rigid_envelope_breaks_under_twice_the_disturbance():
     (["controller.kind=sta", "controller.gain_condition=levant", "controller.k1=0.3"], "controller.k1"),
     (["controller.kind=sta", "controller.gain_condition=levant", "controller.k2=0.08"], "controller.k2"),
     (["controller.kind=ppc", "controller.rho0=[5, 0.5, 0.2]"], "controller.rho0"),  # start on the envelope
-    (["controller.kind=ppc", "controller.rho_inf=[0.005, 2, 0.005]"], "controller.rho_inf"),
+    (["controller.kind=ppc", "controller.rho_inf=[0.005, 2, 0.005]"], "controller.rho_inf"),  # > rho0
     (["controller.kind=backstepping", "controller.adaptive=false", "controller.sigma=0.1"], "controller.sigma"),
 ])
 @pytest.mark.parametrize("command", ["check", "run"])

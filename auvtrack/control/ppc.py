@@ -54,15 +54,16 @@ Pos = Annotated[float, Field(gt=0)]
 class Params(_Params):
     """Prescribed-performance control with the rigid envelope (R1) of Bechlioulis & Rovithakis (2008).
 
-    The envelope's numbers are the paper's Section 4 values except rho0_y: the Section 4 start
-    has |e_y(0)| = 0.5 m, on the paper's rho_{2,0} = 0.5, and a rigid envelope cannot start there.
+    rho_inf is the paper's Section 4 value; rho0 is its 5 m in x and larger in y and z so that
+    every start of the tuning study lies strictly inside (the Section 4 start has |e_y(0)| =
+    0.5 m, on the paper's rho_{2,0} = 0.5 m, and a rigid envelope cannot start there).
     """
 
     kind: Literal["ppc"] = "ppc"
     kp: float = Field(16.0, gt=0, description="gain on eps, 1/s^2")
     kd: float = Field(8.0, gt=0, description="gain on eps_dot, 1/s")
     l: float = Field(0.3, gt=0, description="envelope decay rate, 1/s")
-    rho0: tuple[Pos, Pos, Pos] = Field((5.0, 1.0, 0.2), description="rho(0) per axis, m")
+    rho0: tuple[Pos, Pos, Pos] = Field((5.0, 1.5, 1.0), description="rho(0) per axis, m")
     rho_inf: tuple[Pos, Pos, Pos] = Field((0.005, 0.005, 0.005), description="rho(inf) per axis, m")
 
 
