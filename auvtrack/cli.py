@@ -73,8 +73,11 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
 @click.argument("scenario")
 @set_option
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
-    """Validate SCENARIO without running it."""
+    """Validate SCENARIO without running it (the controller's set-up included, as run does)."""
+    from .simulation.api import prepare
+
     sc = _load(scenario, overrides)
+    prepare(sc)  # the controller's gain conditions: check refuses what run would
     if sc.controller.kind == "fxtntsmc":
         from .control.theory import check_theorem1
 

@@ -2,13 +2,17 @@
 
 Registering a built-in controller is one line: its module in :data:`BUILTIN`.
 """
-from . import ftsmc, fxtntsmc, open_loop
+from . import backstepping, ftsmc, fxtntsmc, open_loop, pid, ppc, sta
 from .params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
 from .registry import CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, get, register
 
 BUILTIN = (
     fxtntsmc,
     ftsmc,
+    pid,
+    backstepping,
+    sta,
+    ppc,
     open_loop,
 )
 for _module in BUILTIN:

@@ -33,8 +33,7 @@ from pydantic import Field
 
 from .._jit import njit, njit_noalloc
 from .gain_checks import require
-from .params import _Params
-from .registry import CompiledController
+from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "backstepping"
@@ -42,7 +41,7 @@ AUX_NAMES = ("z2_x", "z2_y", "z2_z", "b_hat_x", "b_hat_y", "b_hat_z")
 C1, C2, GAMMA, SIGMA = 0, 1, 2, 3
 
 
-class Params(_Params):
+class Params(ControllerParams):
     """Backstepping on (e, e_dot) with an optional adaptive estimate of the lumped disturbance (eq. B1-B4)."""
 
     kind: Literal["backstepping"] = "backstepping"

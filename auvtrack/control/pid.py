@@ -31,8 +31,7 @@ from .._jit import njit, njit_noalloc
 from ..plant.kinematics import j3
 from ..plant.params import ELL, M0
 from .gain_checks import require
-from .params import _Params
-from .registry import CompiledController
+from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, mat_vec
 
 NAME = "pid"
@@ -40,7 +39,7 @@ AUX_NAMES = ("I_x", "I_y", "I_z")
 KP, KI, KD, KAW_KI, TAU_MAX = 0, 1, 2, 3, 4
 
 
-class Params(_Params):
+class Params(ControllerParams):
     """Computed-torque PID on the virtual-point error (docs/controllers.md, eq. P1-P3).
 
     The defaults place the three poles of eq. (P3) at s = -1 rad/s: (s + 1)^3.

@@ -39,8 +39,7 @@ from pydantic import Field
 
 from .._jit import njit, njit_noalloc
 from .gain_checks import fmt, require
-from .params import _Params
-from .registry import CompiledController
+from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "ppc"
@@ -51,7 +50,7 @@ AXES = ("x", "y", "z")
 Pos = Annotated[float, Field(gt=0)]
 
 
-class Params(_Params):
+class Params(ControllerParams):
     """Prescribed-performance control with the rigid envelope (R1) of Bechlioulis & Rovithakis (2008).
 
     rho_inf is the paper's Section 4 value; rho0 is its 5 m in x and larger in y and z so that

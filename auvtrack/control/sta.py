@@ -39,8 +39,7 @@ from pydantic import Field
 
 from .._jit import njit, njit_noalloc
 from .gain_checks import require
-from .params import _Params
-from .registry import CompiledController
+from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "sta"
@@ -48,7 +47,7 @@ AUX_NAMES = ("s_x", "s_y", "s_z", "v_x", "v_y", "v_z")
 LAM, K1, K2 = 0, 1, 2
 
 
-class Params(_Params):
+class Params(ControllerParams):
     """Super-twisting sliding-mode control on s = e_dot + lam e (eq. S1-S5).
 
     ``L`` is the bound on |d chi / dt| that the gain condition is checked against (the
