@@ -214,7 +214,7 @@ def prepare(scenario: Scenario) -> Prepared:
         notes=tuple(cpl.notes) + tuple(cc.notes),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": cc.resolved},
-        statuses={**CONTROLLER_STATUS, **cspec.statuses},
+        statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
     )
 
 
