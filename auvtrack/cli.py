@@ -106,7 +106,8 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 
 
 @cli.command()
-@click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: ftsmc, fxtntsmc).")
+@click.option("--controller", "controllers", multiple=True,
+              help="Controller kind(s), or plugin:FILE.py (default: every built-in controller).")
 @click.option("--repeat", default=7, show_default=True, help="Timed repetitions; the median is reported.")
 @click.option("--duration", default=20.0, show_default=True, help="Simulated seconds per repetition.")
 @click.option("--all", "run_all", is_flag=True,
@@ -115,17 +116,17 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 @click.option("--out", "bench_out", type=click.Path(file_okay=False), default=None,
               help="Folder for the --all results (default: benchmarks/ of the source tree, else .).")
 def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
-    """Time the compiled closed loop; one JSON line per controller with us_per_step."""
-    from .runner.bench import bench_single
-
+    """Time the compiled closed loop; one JSON line per controller with us_per_step (repetitions interleaved)."""
     if run_all:
         from .runner.bench import bench_all
 
         doc = bench_all(repeat=repeat, out=Path(bench_out) if bench_out else None, progress=True)
         click.echo(json.dumps(doc, indent=2))
         return
-    for kind in controllers or ("ftsmc", "fxtntsmc"):
-        click.echo(json.dumps(bench_single(kind, repeat=repeat, duration=duration)))
+    from .runner.bench import bench_singles, builtin_controllers
+
+    for row in bench_singles(controllers or builtin_controllers(), repeat=repeat, duration=duration):
+        click.echo(json.dumps(row))
 
 
 @cli.command()

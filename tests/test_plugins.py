@@ -16,11 +16,11 @@ from scipy.linalg import expm
 
 import auvtrack
 from auvtrack.cli import EXIT_BAD_INPUT, main
-from auvtrack.control import ftsmc
 from auvtrack.control.tracking import error_state
 from auvtrack.plant.kinematics import attitude
 from auvtrack.reference import build_reference
 from auvtrack.runner.batch import run_batch
+from auvtrack.runner.bench import plugin_copy
 from auvtrack.scenario import ScenarioError, load_scenario, paper_scenario_path
 from auvtrack.simulation.api import prepare, run_prepared
 
@@ -148,19 +148,8 @@ def test_a_broken_plugin_is_one_line_naming_the_file_and_the_missing_piece(tmp_p
     assert not (tmp_path / "r").exists()
 
 
-def _copy_as_plugin(module, folder: Path) -> Path:
-    """A built-in controller module's source as a stand-alone plug-in file (absolute imports)."""
-    src = Path(module.__file__).read_text()
-    src = re.sub(r"from \.\.(\w+)", r"from auvtrack.\1", src)
-    src = re.sub(r"from \.(\w+)", r"from auvtrack.control.\1", src)
-    src = src.replace("from . import", "from auvtrack.control import")
-    path = folder / f"copy_of_{module.NAME}.py"
-    path.write_text(src)
-    return path
-
-
 def test_a_plugin_copy_of_a_builtin_law_is_bit_identical_to_it(tmp_path):
-    path = _copy_as_plugin(ftsmc, tmp_path)
+    path = plugin_copy("ftsmc", tmp_path)  # the module with absolute imports, as a file
     built = _quiet_run(paper_scenario_path(), ["controller={kind=\"ftsmc\", k1=0.07}", "sim.duration=20"])
     plug = _quiet_run(paper_scenario_path(), [f"controller={{kind=\"plugin\", module=\"{path}\", "
                                               "params={k1=0.07}}", "sim.duration=20"])
