@@ -126,3 +126,19 @@ def test_quick_study_end_to_end(tmp_path):
         assert raw["provenance"]["evaluations"] == tuning.QUICK.evaluations(len(space.names))
         load_scenario({"controller": {"kind": kind, **raw["gains"]}})
     assert (tmp_path / "results.json").exists()
+
+
+def test_every_controller_gets_the_same_budget():
+    """24 candidates per generation whether a controller tunes three gains or four: 360 gain vectors."""
+    for space in tuning.SPACES.values():
+        n = len(space.names)
+        assert tuning.FULL.de_popsize(n) * n == tuning.FULL.population == 24
+        assert tuning.FULL.evaluations(n) == tuning.FULL.max_evaluations == 360
+
+
+def test_gains_the_controller_refuses_are_an_error_the_objective_penalises():
+    case = tuning.TRAIN_CASES[0]
+    with pytest.raises(ValueError, match="controller.ki"):  # ki >= kd kp: not Hurwitz
+        tuning.run_cost(case, "pid", {"kp": 1.0, "ki": 5.0, "kd": 1.0}, 1.0, 0.002, tuning.Objective())
+    with pytest.raises(ValueError, match="controller.k2"):  # below the Moreno-Osorio bound
+        tuning.run_cost(case, "sta", {"lam": 1.0, "k1": 1.0, "k2": 0.05}, 1.0, 0.002, tuning.Objective())
