@@ -296,7 +296,7 @@ def test_sta_sliding_variable_reaches_zero_in_finite_time_within_the_lyapunov_bo
         P, _, gamma = _sta_lyapunov(k1, k2)
         floor = 0.0
         for a in "xyz":
-            s, v = res[f"s_{a}"], res[f"v_{a}"]
+            s, v = res[f"sliding_{a}"], res[f"integral_{a}"]
             zeta = np.stack([np.sqrt(np.abs(s)) * np.sign(s), v])
             rootV = np.sqrt(np.einsum("in,ij,jn->n", zeta, P, zeta))
             T = 2 * rootV[0] / gamma

@@ -154,7 +154,7 @@ def test_a_plugin_copy_of_a_builtin_law_is_bit_identical_to_it(tmp_path):
     plug = _quiet_run(paper_scenario_path(), [f"controller={{kind=\"plugin\", module=\"{path}\", "
                                               "params={k1=0.07}}", "sim.duration=20"])
     assert built.ok and plug.ok
-    for name in ("x", "y", "z", "theta", "psi", "u", "tau_u", "tau_q", "tau_r", "s_x", "s_y", "s_z"):
+    for name in ("x", "y", "z", "theta", "psi", "u", "tau_u", "tau_q", "tau_r", "sliding_x", "sliding_y", "sliding_z"):
         np.testing.assert_array_equal(plug[name], built[name], err_msg=name)
     assert plug.metrics == built.metrics
 

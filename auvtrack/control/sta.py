@@ -26,8 +26,8 @@ Int. J. Control 58(6), 1247-1263 (the super-twisting algorithm and its convergen
 Moreno, J. A. & Osorio, M. (2012), Strict Lyapunov functions for the super-twisting algorithm,
 IEEE Trans. Autom. Control 57(4), 1035-1040 (the Lyapunov function V).
 
-Packed ``cp`` = [lam, k1, k2]; internal state xc = v (3, m/s^2); logged aux: s_x, s_y, s_z,
-v_x, v_y, v_z.
+Packed ``cp`` = [lam, k1, k2]; internal state xc = v (3, m/s^2); logged aux: sliding_x, sliding_y, sliding_z (s),
+integral_x, integral_y, integral_z (v).
 """
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "sta"
-AUX_NAMES = ("s_x", "s_y", "s_z", "v_x", "v_y", "v_z")
+AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z", "integral_x", "integral_y", "integral_z")  # s and v
 LAM, K1, K2 = 0, 1, 2
 
 
