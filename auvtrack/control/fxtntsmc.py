@@ -21,8 +21,8 @@ eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
 
 Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels per axis: rho (envelope),
 rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger),
-zeta (z, the transformed error) and Geff (the effective gain G = Omega - c1; Omega = rho/(rho^2 - e^2)
-of eq. 18 follows from the logged rho and e).
+zeta (z, the transformed error) and gain_ratio (G/Omega: the effective gain G = Omega - c1 with
+which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band).
 """
 from __future__ import annotations
 
@@ -42,7 +42,8 @@ from .tracking import error_state_forces, input_for_accel_forces, sign
 NAME = "fxtntsmc"
 AXES = ("x", "y", "z")
 # channel names (formerly S_* and z_*, still readable: auvtrack/simulation/channels.py)
-AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding", "g", "zeta", "Geff") for a in AXES)
+AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding", "g", "zeta", "gain_ratio")
+                  for a in AXES)
 
 # Packed parameters cp (built by :func:`setup`):
 #   0-11   kappa1, kappa2, kappa3, a1, a2, a3, a4, alpha, sigma, surface code, z_switch, z_floor
@@ -249,7 +250,7 @@ def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux):
     edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / G
     dxc[RHO_BAR + i] = rbd
     aux[i], aux[3 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, S, g, z
-    aux[18 + i] = G
+    aux[18 + i] = G / Om  # exactly 1 where c1 = 0
     return S, edd, Om, G
 
 

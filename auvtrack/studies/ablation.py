@@ -364,22 +364,20 @@ def _run(sc) -> Result:
 def band_gain_ratio(res: Result, t_from: float = 0.0) -> dict[str, Any] | None:
     """G / Omega over the logged samples inside the risk monitor's band (0 < g < 1), all axes.
 
-    G is the logged ``Geff_*``; Omega = rho / (rho^2 - e^2) (eq. 18) from the logged ``rho_*`` and ``e*``.
+    The ratio is the logged ``gain_ratio_*`` channel (the controller's G and Omega at the same instant).
 
     Returns ``{"samples", "min", "median", "max"}`` or None when the run logs no effective gain
     or never enters the band after ``t_from``.
     """
     ch = res.channels
-    if "Geff_x" not in ch or not ch["t"].size:
+    if "gain_ratio_x" not in ch or not ch["t"].size:
         return None
     sel = ch["t"] >= t_from
     vals = []
     for a in "xyz":
         g = ch[f"g_{a}"][sel]
         band = (g > 0) & (g < 1)
-        rho, e = ch[f"rho_{a}"][sel], ch[f"e{a}"][sel]
-        omega = rho / (rho * rho - e * e)  # eq. (18)
-        vals.append((ch[f"Geff_{a}"][sel] / omega)[band])
+        vals.append(ch[f"gain_ratio_{a}"][sel][band])
     v = np.concatenate(vals)
     if not v.size:
         return None
