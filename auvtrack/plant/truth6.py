@@ -1,0 +1,131 @@
+"""The 6-DOF truth models by preset: packing the parameters, and a Python-side reference integrator.
+
+``MODELS`` maps a preset name to its model module (:mod:`auvtrack.plant.prestero`,
+:mod:`auvtrack.plant.fossen_remus`); each provides ``pack(preset, common)``, the compiled
+``derivative(x, vc, dist, cmd, pp, dx)``, ``produced`` and ``allocate_tau``.
+:func:`pack_truth` builds the packed parameters with the actuator block filled from the preset
+(optionally overridden, e.g. by ``plant.delta_rate_max``).
+"""
+from __future__ import annotations
+
+import math
+from types import ModuleType
+
+import numpy as np
+
+from . import fossen_remus, prestero
+from .layout6 import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_NMAX, P_NRATE,
+                      P_TDELTA, P_TN, PP6_SIZE)
+from .presets6 import Preset6, load_preset6
+
+MODELS: dict[str, ModuleType] = {"remus100_prestero": prestero, "remus100_fossen": fossen_remus}
+
+ACTUATOR_KEYS = ("delta_max", "n_max", "T_delta", "T_n", "delta_rate_max", "n_rate_max")
+_SLOTS = dict(zip(ACTUATOR_KEYS, (P_DMAX, P_NMAX, P_TDELTA, P_TN, P_DRATE, P_NRATE)))
+_RANGES = {"delta_max": (0.0, math.pi / 2, "rad, in (0, pi/2]"), "n_max": (0.0, math.inf, "rpm, > 0"),
+           "T_delta": (0.0, math.inf, "s, > 0"), "T_n": (0.0, math.inf, "s, > 0"),
+           "delta_rate_max": (0.0, math.inf, "rad/s, > 0 (inf = none)"),
+           "n_rate_max": (0.0, math.inf, "rpm/s, > 0 (inf = none)")}
+
+
+def actuator_values(pr: Preset6, overrides: dict | None = None) -> dict:
+    """The actuator numbers of a preset with ``overrides`` applied, checked.
+
+    Raises
+    ------
+    ValueError
+        ``"plant.<key>: must be <range> (got <value>)"`` for a value out of range.
+    """
+    vals = {k: pr.values[f"actuators.{k}"] for k in ACTUATOR_KEYS}
+    for k, x in (overrides or {}).items():
+        if k not in vals:
+            raise ValueError(f"plant.{k}: unknown actuator setting; allowed {list(ACTUATOR_KEYS)}")
+        vals[k] = float(x)
+    for k, x in vals.items():
+        lo, hi, text = _RANGES[k]
+        if not (x > lo and (x <= hi)) or math.isnan(x) or (k in ("delta_max", "n_max", "T_delta", "T_n") and math.isinf(x)):
+            raise ValueError(f"plant.{k}: must be {text} (got {x})")
+    return vals
+
+
+def pack_truth(name: str, overrides: dict | None = None, direct: bool = False) -> np.ndarray:
+    """Packed parameters ``pp`` of the 6-DOF preset ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`MODELS`.
+    overrides : dict, optional
+        Actuator settings replacing the preset's (keys :data:`ACTUATOR_KEYS`).
+    direct : bool
+        The controller commands the actuators directly (``open_loop_actuators``).
+
+    Returns
+    -------
+    numpy.ndarray
+        Length :data:`auvtrack.plant.layout6.PP6_SIZE`.
+    """
+    pr = load_preset6(name)
+    common = np.zeros(PP6_SIZE)
+    for k, x in actuator_values(pr, overrides).items():
+        common[_SLOTS[k]] = x
+    common[P_DIRECT] = 1.0 if direct else 0.0
+    return MODELS[name].pack(pr, common)
+
+
+def initial_state(eta6=(0.0,) * 6, nu6=(0.0,) * 6, actuators=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """x0 (length :data:`NX6`) from pose, velocity and actuator states (rad, rad, rpm)."""
+    x = np.zeros(NX6)
+    x[0:6], x[6:12] = eta6, nu6
+    x[IX_DR], x[IX_DS], x[IX_N] = actuators
+    return x
+
+
+def integrate_open_loop(name: str, commands, t_end: float, dt: float, x0=None,
+                        vc=(0.0, 0.0, 0.0), times=()) -> dict:
+    """RK4 of the truth model under constant actuator commands (a reference for tests and checks).
+
+    Parameters
+    ----------
+    name : str
+        Preset.
+    commands : sequence of 3 float
+        (delta_r (rad), delta_s (rad), n (rpm)).
+    t_end, dt : float
+        Duration and step (s).
+    x0 : array_like, optional
+        Initial state (default: at rest, actuators at 0).
+    vc : sequence of 3 float
+        Constant NED current (m/s).
+    times : sequence of float
+        Times (multiples of dt) at which to return the state.
+
+    Returns
+    -------
+    dict
+        ``{t: state}`` for each requested time, and ``"final"``.
+    """
+    model = MODELS[name]
+    pp = pack_truth(name)
+    x = initial_state() if x0 is None else np.array(x0, dtype=np.float64)
+    cmd = np.zeros(6)
+    cmd[0:3] = commands
+    dist = (0.0,) * 6
+    vc = tuple(float(c) for c in vc)
+    k1, k2, k3, k4, xs = (np.zeros(NX6) for _ in range(5))
+    want = {int(round(t / dt)): t for t in times}
+    out = {}
+    nsteps = int(round(t_end / dt))
+    for i in range(nsteps):
+        model.derivative(x, vc, dist, cmd, pp, k1)
+        np.add(x, 0.5 * dt * k1, out=xs)
+        model.derivative(xs, vc, dist, cmd, pp, k2)
+        np.add(x, 0.5 * dt * k2, out=xs)
+        model.derivative(xs, vc, dist, cmd, pp, k3)
+        np.add(x, dt * k3, out=xs)
+        model.derivative(xs, vc, dist, cmd, pp, k4)
+        x += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        if i + 1 in want:
+            out[want[i + 1]] = x.copy()
+    out["final"] = x.copy()
+    return out
