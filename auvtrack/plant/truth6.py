@@ -82,7 +82,7 @@ def initial_state(eta6=(0.0,) * 6, nu6=(0.0,) * 6, actuators=(0.0, 0.0, 0.0)) ->
 
 
 def integrate_open_loop(name: str, commands, t_end: float, dt: float, x0=None,
-                        vc=(0.0, 0.0, 0.0), times=()) -> dict:
+                        vc=(0.0, 0.0, 0.0), times=(), pp=None, dist=(0.0,) * 6) -> dict:
     """RK4 of the truth model under constant actuator commands (a reference for tests and checks).
 
     Parameters
@@ -99,6 +99,10 @@ def integrate_open_loop(name: str, commands, t_end: float, dt: float, x0=None,
         Constant NED current (m/s).
     times : sequence of float
         Times (multiples of dt) at which to return the state.
+    pp : numpy.ndarray, optional
+        Packed parameters (default: the preset's, :func:`pack_truth`).
+    dist : sequence of 6 float
+        Constant disturbance [X, Y, Z, K, M, N] (N, N m).
 
     Returns
     -------
@@ -106,11 +110,11 @@ def integrate_open_loop(name: str, commands, t_end: float, dt: float, x0=None,
         ``{t: state}`` for each requested time, and ``"final"``.
     """
     model = MODELS[name]
-    pp = pack_truth(name)
+    pp = pack_truth(name) if pp is None else pp
     x = initial_state() if x0 is None else np.array(x0, dtype=np.float64)
     cmd = np.zeros(6)
     cmd[0:3] = commands
-    dist = (0.0,) * 6
+    dist = tuple(float(d) for d in dist)
     vc = tuple(float(c) for c in vc)
     k1, k2, k3, k4, xs = (np.zeros(NX6) for _ in range(5))
     want = {int(round(t / dt)): t for t in times}
