@@ -16,7 +16,9 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_v
 
 from ..control.params import (FTSMCParams, FXTNTSMCParams, OpenLoopParams, available_gain_presets,
                               get_gain_preset)
-from ..plant.presets import available, get_preset
+from ..plant.presets import available, get_preset, is_reduced
+from ..plant.reduction import U0_MAX, U0_MIN, default_u0
+from ..reference import build_reference
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
 
@@ -128,6 +130,11 @@ class VehicleSection(_Section):
     wgml: NonNeg | None = Field(None, description="rho g nabla GM_L, N m")
     l: Annotated[Num, Field(gt=0, le=10)] | None = Field(  # noqa: E741 - paper's symbol
         None, description="virtual-point offset ell, m (ell = 0 makes J3 singular)")
+    # --- issue 11: linearisation speed of a reduced preset (begin) -------------------------------
+    u0: Annotated[Num, Field(ge=U0_MIN, le=U0_MAX)] | None = Field(
+        None, description="linearisation speed of a reduced preset (remus100), m/s; default: the "
+                          "mean speed of the scenario's reference")
+    # --- issue 11 (end) --------------------------------------------------------------------------
 
     @model_validator(mode="before")
     @classmethod
@@ -140,7 +147,13 @@ class VehicleSection(_Section):
         names = available()
         if name not in names:
             raise ValueError(f"preset: unknown preset (allowed: {', '.join(names)}) (got {name!r})")
-        pre = get_preset(name)
+        # --- issue 11: a reduced preset is computed at vehicle.u0 (begin) ---
+        u0 = data.get("u0")
+        if u0 is not None and not is_reduced(name):
+            raise ValueError(f"u0: only a reduced preset ({', '.join(n for n in names if is_reduced(n))}) "
+                             f"has a linearisation speed; {name!r} has none (got {format_value(u0)})")
+        pre = get_preset(name, u0=u0 if isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX else None)
+        # --- issue 11 (end) ---
         out = dict(data)
         for key in _VEHICLE_FIELDS:
             if out.get(key) is None:
@@ -157,8 +170,10 @@ class VehicleSection(_Section):
             per number ``{"unit", "source", "origin"}`` with ``origin`` ``"preset"`` or
             ``"scenario"`` (an override differing from the preset value).
         """
-        pre = get_preset(self.preset)
+        pre = get_preset(self.preset, u0=self.u0)  # issue 11: reduced presets at u0
         out: dict[str, Any] = {"preset": pre.name, "description": pre.description}
+        if pre.u0 is not None:
+            out["u0"] = pre.u0
         sources: dict[str, dict[str, str]] = {}
         for key in _VEHICLE_FIELDS:
             value, preset_value = getattr(self, key), getattr(pre, key)
@@ -410,6 +425,28 @@ class Scenario(BaseModel):
     actuator: ActuatorSection = Field(default_factory=ActuatorSection)
     sensor: SensorSection = Field(default_factory=SensorSection)
 
+    # --- issue 11: a reduced vehicle preset is linearised at the reference's speed (begin) -----
+    @model_validator(mode="before")
+    @classmethod
+    def _reduction_speed(cls, data: Any) -> Any:
+        """Fill ``vehicle.u0`` of a reduced preset with the mean speed of the reference."""
+        if not isinstance(data, Mapping):
+            return data
+        veh = data.get("vehicle", {})
+        if not isinstance(veh, Mapping) or veh.get("u0") is not None:
+            return data
+        name = veh.get("preset", "paper")
+        if not isinstance(name, str) or not is_reduced(name):
+            return data
+        try:  # an invalid reference or duration is reported by its own validator
+            ref = build_reference(check_reference(data.get("reference", {"kind": "helix"})))
+            sim = data.get("sim", {})
+            duration = float(sim.get("duration", SimSection.model_fields["duration"].default))
+        except (ValueError, TypeError, AttributeError):
+            return data
+        return {**data, "vehicle": {**veh, "u0": default_u0(ref, duration)}}
+    # --- issue 11 (end) ---------------------------------------------------------------------------
+
     @field_validator("name")
     @classmethod
     def _name(cls, v: str) -> str:
@@ -460,4 +497,7 @@ class Scenario(BaseModel):
         lists and an infinite value (``metrics.window[1]``) is written as the string ``"inf"``.
         ``load_scenario(s.to_dict()) == s``.
         """
-        return jsonable(self.model_dump(mode="python"))
+        out = jsonable(self.model_dump(mode="python"))
+        if out["vehicle"].get("u0") is None:  # issue 11: only a reduced preset has a u0
+            out["vehicle"].pop("u0", None)
+        return out
