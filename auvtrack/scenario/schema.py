@@ -17,7 +17,11 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_v
 from ..control.params import (FTSMCParams, FXTNTSMCParams, OpenLoopParams, available_gain_presets,
                               get_gain_preset)
 from ..plant.presets import available, get_preset, is_reduced
+from ..plant.presets6 import available6, load_preset6
 from ..plant.reduction import U0_MAX, U0_MIN, default_u0
+from ..plant.truth6 import actuator_values
+
+DEFAULT_PLANT_PRESET = "remus100_prestero"
 from ..reference import build_reference
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
@@ -25,7 +29,7 @@ from .errors import format_value
 __all__ = [
     "CONTROLLER_MODELS", "ControllerParams", "Scenario", "SimSection", "VehicleSection",
     "UncertaintySection", "InitialSection", "EnvelopeSection", "EstimatorSection",
-    "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection",
+    "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection", "PlantSection",
 ]
 
 # --- strict scalar types ------------------------------------------------------------------------
@@ -79,6 +83,8 @@ class SimSection(_Section):
     log_dt: Pos = Field(0.01, description="logging interval, s (integer multiple of dt)")
     control_rate: NonNeg = Field(0.0, description="Hz; 0 = continuous (every RK4 stage)")
     theta_limit: Annotated[Num, Field(gt=0, lt=90)] = Field(85.0, description="|pitch| stop, deg")
+    phi_limit: Annotated[Num, Field(gt=0, le=180)] = Field(  # issue 11: 6-DOF truth plants
+        85.0, description="|roll| stop, deg (6-DOF plants; the 5-DOF plant has no roll)")
     state_limit: Pos = Field(1e6, description="abs bound on every state before divergence")
     integrator: Literal["rk4"] = "rk4"
 
@@ -203,6 +209,9 @@ class InitialSection(_Section):
 
     eta: Vec5 = Field((0.0, 0.5, 0.0, 0.0, 0.0), description="m, m, m, rad, rad")
     nu: Vec5 = Field((0.0, 0.0, 0.0, 0.0, 0.0), description="m/s, m/s, m/s, rad/s, rad/s")
+    # issue 11: roll and roll rate of a 6-DOF truth plant (0 for the 5-DOF plant)
+    phi: Annotated[Num, Field(gt=-math.pi / 2, lt=math.pi / 2)] = Field(0.0, description="roll, rad (6-DOF plants)")
+    p: Annotated[Num, Field(ge=-10.0, le=10.0)] = Field(0.0, description="roll rate, rad/s (6-DOF plants)")
 
     @field_validator("eta")
     @classmethod
@@ -241,6 +250,69 @@ class SensorSection(_Section):
 
     sigma_eta: NonNeg5 = Field((0.0,) * 5, description="std of x, y, z (m), theta, psi (rad)")
     sigma_nu: NonNeg5 = Field((0.0,) * 5, description="std of u, v, w (m/s), q, r (rad/s)")
+
+
+# --- issue 11: the truth plant (begin) ---------------------------------------------------------
+PLANT_ACTUATOR_KEYS = ("delta_max", "n_max", "T_delta", "T_n", "delta_rate_max", "n_rate_max")
+
+
+class PlantSection(_Section):
+    """``[plant]``: the truth plant the controller flies (docs/vehicles.md).
+
+    ``model = "5dof"``: the paper's model with the ``[vehicle]`` numbers and ``[uncertainty]``;
+    ``model = "6dof"``: a 6-DOF truth model ``preset`` with fins, propeller and actuator states,
+    which the controller does not know (it keeps ``[vehicle]`` as its design model).  The
+    actuator keys override the preset's (6-DOF only).
+    """
+
+    model: Literal["5dof", "6dof"] = Field("5dof", description="'5dof' (paper eq. 1) or '6dof' (a truth preset)")
+    preset: Str | None = Field(None, description="6-DOF preset: remus100_prestero (default) or remus100_fossen")
+    delta_max: Annotated[Num, Field(gt=0, le=math.pi / 2)] | None = Field(None, description="fin angle limit, rad")
+    n_max: Pos | None = Field(None, description="propeller speed limit, rpm")
+    T_delta: Pos | None = Field(None, description="fin time constant, s")
+    T_n: Pos | None = Field(None, description="propeller time constant, s")
+    delta_rate_max: PosOrInf | None = Field(None, description="fin rate limit, rad/s (inf = none)")
+    n_rate_max: PosOrInf | None = Field(None, description="propeller rate limit, rpm/s (inf = none)")
+
+    @field_validator("delta_rate_max", "n_rate_max", mode="before")
+    @classmethod
+    def _word(cls, v: Any) -> Any:
+        return _inf_words([v])[0] if isinstance(v, str) else v
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_preset(cls, data: Any) -> Any:
+        if isinstance(data, Mapping) and data.get("model") == "6dof" and data.get("preset") is None:
+            return {**data, "preset": DEFAULT_PLANT_PRESET}
+        return data
+
+    @model_validator(mode="after")
+    def _preset(self) -> "PlantSection":
+        if self.model == "5dof":
+            given = [k for k in ("preset", *PLANT_ACTUATOR_KEYS) if getattr(self, k) is not None]
+            if given:
+                raise ValueError(f"{given[0]}: only for plant.model = \"6dof\" "
+                                 f"(got {format_value(getattr(self, given[0]))} with model \"5dof\")")
+            return self
+        names = available6()
+        if self.preset not in names:
+            raise ValueError(f"preset: unknown 6-DOF preset (allowed: {', '.join(names)}) (got {self.preset!r})")
+        try:
+            actuator_values(load_preset6(self.preset), self.actuator_overrides())
+        except ValueError as exc:  # "plant.<key>: ..." -> "<key>: ..."
+            raise ValueError(str(exc).removeprefix("plant.")) from None
+        return self
+
+    def actuator_overrides(self) -> dict[str, float]:
+        """The actuator keys given (6-DOF): name -> value."""
+        return {k: getattr(self, k) for k in PLANT_ACTUATOR_KEYS if getattr(self, k) is not None}
+
+    def actuator_limits(self) -> dict[str, float] | None:
+        """Effective actuator numbers of a 6-DOF plant (preset with overrides); None for 5dof."""
+        if self.model != "6dof":
+            return None
+        return actuator_values(load_preset6(self.preset), self.actuator_overrides())
+# --- issue 11 (end) ------------------------------------------------------------------------------
 
 
 class EnvelopeSection(_Section):
@@ -424,6 +496,7 @@ class Scenario(BaseModel):
     output: OutputSection = Field(default_factory=OutputSection)
     actuator: ActuatorSection = Field(default_factory=ActuatorSection)
     sensor: SensorSection = Field(default_factory=SensorSection)
+    plant: PlantSection = Field(default_factory=PlantSection)  # issue 11
 
     # --- issue 11: a reduced vehicle preset is linearised at the reference's speed (begin) -----
     @model_validator(mode="before")
@@ -477,6 +550,29 @@ class Scenario(BaseModel):
                 _check_numbers(model, v)
         return v
 
+    # --- issue 11: options that exist for one plant model only (begin) --------------------------
+    @model_validator(mode="after")
+    def _plant_options(self) -> "Scenario":
+        """5-DOF-only options with a 6-DOF truth, and roll initial values with the 5-DOF plant."""
+        if self.plant.model == "6dof":
+            default = UncertaintySection()
+            for k in ("C", "D", "M", "G"):
+                if getattr(self.uncertainty, k) != getattr(default, k):
+                    raise ValueError(f"uncertainty.{k}: scales the 5-DOF plant only; with plant.model = \"6dof\" "
+                                     f"the truth is the preset {self.plant.preset!r} (got {format_value(getattr(self.uncertainty, k))})")
+            for k in ("tau_max", "rate_max"):
+                v = getattr(self.actuator, k)
+                if any(math.isfinite(x) for x in v):
+                    raise ValueError(f"actuator.{k}: limits the 5-DOF input only; with plant.model = \"6dof\" the fins "
+                                     f"and propeller limit it (plant.delta_max, plant.n_max, ...) (got {format_value(v)})")
+        else:
+            for k in ("phi", "p"):
+                if getattr(self.initial, k) != 0.0:
+                    raise ValueError(f"initial.{k}: roll exists only with plant.model = \"6dof\" "
+                                     f"(got {format_value(getattr(self.initial, k))})")
+        return self
+    # --- issue 11 (end) ---------------------------------------------------------------------------
+
     @model_validator(mode="after")
     def _sampled_only(self) -> "Scenario":
         """Rate limits and sensor noise act between control samples: they need a control rate."""
@@ -500,4 +596,5 @@ class Scenario(BaseModel):
         out = jsonable(self.model_dump(mode="python"))
         if out["vehicle"].get("u0") is None:  # issue 11: only a reduced preset has a u0
             out["vehicle"].pop("u0", None)
+        out["plant"] = {k: v for k, v in out["plant"].items() if v is not None}  # issue 11: 6-DOF-only keys
         return out
