@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from auvtrack.plant import fossen_remus, prestero
 from auvtrack.plant.actuators6 import effective
+from auvtrack.plant.kinematics import attitude
 from auvtrack.plant.layout6 import (CMD_DR, CMD_DS, CMD_N, NX6, P_B, P_DMAX, P_MA, P_MINV, P_MODEL,
                                     P_MRB, P_NMAX, P_W, PP6_SIZE)
 from auvtrack.plant.presets6 import SHIPPED6, available6, load_preset6
@@ -67,7 +68,7 @@ def test_state_derivative_kinematic_part(name):
     pp = pack_truth(name)
     x = initial_state((1.0, 2.0, 3.0, 0.2, -0.3, 1.1), (1.2, 0.1, -0.05, 0.03, 0.02, -0.04))
     dx = np.zeros(NX6)
-    MODELS[name].derivative(x, (0.0, 0.0, 0.0), (0.0,) * 6, np.zeros(6), pp, dx)
+    MODELS[name].derivative(x, attitude(x[4], x[5]), (0.0, 0.0, 0.0), (0.0,) * 6, np.zeros(6), pp, dx)
     tr = trig6(*x[3:6])
     assert np.allclose(dx[0:3], ned_velocity(tr, *x[6:9]), rtol=0, atol=1e-15)
     assert np.allclose(dx[3:6], euler_rates(tr, *x[9:12]), rtol=0, atol=1e-15)
@@ -128,7 +129,8 @@ def _energy_drift(name, dt, t_end=20.0):
     M = np.linalg.inv(pp[P_MINV:P_MINV + 36].reshape(6, 6))
     x = initial_state((0, 0, 0, 0.1, 0.2, 0.3), (0.8, 0.3, -0.2, 0.6, 0.5, -0.7))
     cmd = np.zeros(6)
-    f = MODELS[name].derivative
+    def f(z, vc, dist, cmd, pp, out):
+        MODELS[name].derivative(z, attitude(z[4], z[5]), vc, dist, cmd, pp, out)
     k = [np.zeros(NX6) for _ in range(4)]
     E0 = 0.5 * x[6:12] @ M @ x[6:12]
     for _ in range(int(round(t_end / dt))):
@@ -190,7 +192,8 @@ def _derivative(name, x, cmd=(0.0, 0.0, 0.0), pp=None, dist=(0.0,) * 6):
     c = np.zeros(6)
     c[0:3] = cmd
     dx = np.zeros(NX6)
-    MODELS[name].derivative(np.asarray(x, float), (0.0, 0.0, 0.0), tuple(dist), c, pp, dx)
+    x = np.asarray(x, float)
+    MODELS[name].derivative(x, attitude(x[4], x[5]), (0.0, 0.0, 0.0), tuple(dist), c, pp, dx)
     return dx
 
 
@@ -298,7 +301,7 @@ def test_fin_rate_limit_acts():
     dx = np.zeros(NX6)
     cmd = np.zeros(6)
     cmd[CMD_DR] = 0.2
-    fossen_remus.derivative(x, (0.0, 0.0, 0.0), (0.0,) * 6, cmd, pp, dx)
+    fossen_remus.derivative(x, attitude(0.0, 0.0), (0.0, 0.0, 0.0), (0.0,) * 6, cmd, pp, dx)
     assert dx[12] == 0.05  # (0.2 - 0)/0.1 = 2 rad/s limited to 0.05
 
 

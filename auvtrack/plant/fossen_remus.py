@@ -51,7 +51,7 @@ from .layout6 import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL,
                       P_RG, P_W, PP6_SIZE)
 from .presets6 import Preset6
 from .rigid6 import (check_spd, euler_rates, inertia_about_origin, kirchhoff, matvec6, ned_velocity,
-                     restoring, rigid_body_mass, trig6)
+                     restoring, rigid_body_mass, trig_att)
 
 (FZ_RHO, FZ_S, FZ_CD0, FZ_CLA, FZ_KIND, FZ_CCF, FZ_L, FZ_NSTRIP,
  FZ_D0, FZ_D1, FZ_D2, FZ_D3, FZ_D4, FZ_D5,
@@ -221,7 +221,8 @@ def lift_drag(ur, wr, U_r, pp):
     CD = pp[FZ_CD0] + CL * CL * pp[FZ_KIND]
     qS = 0.5 * pp[FZ_RHO] * U_r * U_r * pp[FZ_S]
     fd, fl = qS * CD, qS * CL
-    ca, sa = math.cos(alpha), math.sin(alpha)
+    hyp = math.sqrt(ur * ur + wr * wr)  # cos alpha = u_r / hyp, sin alpha = w_r / hyp (alpha = 0 at rest)
+    ca, sa = (ur / hyp, wr / hyp) if hyp > 0.0 else (1.0, 0.0)
     return -ca * fd + sa * fl, -sa * fd - ca * fl
 
 
@@ -244,9 +245,9 @@ def cross_flow(vr, r, pp):
 
 
 @njit_noalloc
-def derivative(x, vc, dist, cmd, pp, dx):
+def derivative(x, att, vc, dist, cmd, pp, dx):
     """dx[0:15] = f(x, cmd) of the module docstring (arguments as :func:`auvtrack.plant.prestero.derivative`)."""
-    tr = trig6(x[3], x[4], x[5])
+    tr = trig_att(x[3], att)
     u, v, w, p, q, r = x[6], x[7], x[8], x[9], x[10], x[11]
     cps, sps = tr[4], tr[5]
     uc = vc[0] * cps + vc[1] * sps

@@ -44,7 +44,7 @@ from .layout6 import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL,
                       P_RG, P_W, PP6_SIZE)
 from .presets6 import Preset6
 from .rigid6 import (body_from_ned6, check_spd, euler_rates, kirchhoff, matvec6, ned_velocity,
-                     restoring, rigid_body_mass, trig6)
+                     restoring, rigid_body_mass, trig_att)
 
 # model block: quadratic drag (10), lift (8), fins (4), propeller (3)
 (Q_XUU, Q_YVV, Q_YRR, Q_ZWW, Q_ZQQ, Q_KPP, Q_MWW, Q_MQQ, Q_NVV, Q_NRR,
@@ -188,13 +188,15 @@ def hydro(ur, vr, wr, p, q, r, dr, ds, n, pp):
 
 
 @njit_noalloc
-def derivative(x, vc, dist, cmd, pp, dx):
+def derivative(x, att, vc, dist, cmd, pp, dx):
     """dx[0:15] = f(x, cmd) of the module docstring.
 
     Parameters
     ----------
     x : ndarray (15,)
         State (layout :mod:`auvtrack.plant.layout6`).
+    att : tuple of 4 float
+        (cos theta, sin theta, cos psi, sin psi) of x (the engine computes them once per stage).
     vc : tuple of 3 float
         Current velocity in NED (m/s), constant over the call.
     dist : tuple of 6 float
@@ -206,7 +208,7 @@ def derivative(x, vc, dist, cmd, pp, dx):
     dx : ndarray (15,)
         Output.
     """
-    tr = trig6(x[3], x[4], x[5])
+    tr = trig_att(x[3], att)
     u, v, w, p, q, r = x[6], x[7], x[8], x[9], x[10], x[11]
     uc, vcb, wc = body_from_ned6(tr, vc[0], vc[1], vc[2])
     ur, vr, wr = u - uc, v - vcb, w - wc

@@ -49,6 +49,12 @@ def trig6(phi, theta, psi):
 
 
 @njit_noalloc(inline="always")
+def trig_att(phi, att):
+    """:func:`trig6` from roll (rad) and att = (cos theta, sin theta, cos psi, sin psi)."""
+    return math.cos(phi), math.sin(phi), att[0], att[1], att[2], att[3]
+
+
+@njit_noalloc(inline="always")
 def rotation(tr):
     """R(phi, theta, psi) of Fossen 2021 eq. (2.18) (body -> NED) as a tuple of rows; ``tr`` from :func:`trig6`."""
     cf, sf, ct, st, cp, sp = tr

@@ -2,7 +2,7 @@
 
 ``MODELS`` maps a preset name to its model module (:mod:`auvtrack.plant.prestero`,
 :mod:`auvtrack.plant.fossen_remus`); each provides ``pack(preset, common)``, the compiled
-``derivative(x, vc, dist, cmd, pp, dx)``, ``produced`` and ``allocate_tau``.
+``derivative(x, att, vc, dist, cmd, pp, dx)``, ``produced`` and ``allocate_tau``.
 :func:`pack_truth` builds the packed parameters with the actuator block filled from the preset
 (optionally overridden, e.g. by ``plant.delta_rate_max``).
 """
@@ -14,6 +14,7 @@ from types import ModuleType
 import numpy as np
 
 from . import fossen_remus, prestero
+from .kinematics import attitude
 from .layout6 import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_NMAX, P_NRATE,
                       P_TDELTA, P_TN, PP6_SIZE)
 from .presets6 import Preset6, load_preset6
@@ -120,14 +121,16 @@ def integrate_open_loop(name: str, commands, t_end: float, dt: float, x0=None,
     want = {int(round(t / dt)): t for t in times}
     out = {}
     nsteps = int(round(t_end / dt))
+    def f(z, k):
+        model.derivative(z, attitude(z[4], z[5]), vc, dist, cmd, pp, k)
     for i in range(nsteps):
-        model.derivative(x, vc, dist, cmd, pp, k1)
+        f(x, k1)
         np.add(x, 0.5 * dt * k1, out=xs)
-        model.derivative(xs, vc, dist, cmd, pp, k2)
+        f(xs, k2)
         np.add(x, 0.5 * dt * k2, out=xs)
-        model.derivative(xs, vc, dist, cmd, pp, k3)
+        f(xs, k3)
         np.add(x, dt * k3, out=xs)
-        model.derivative(xs, vc, dist, cmd, pp, k4)
+        f(xs, k4)
         x += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
         if i + 1 in want:
             out[want[i + 1]] = x.copy()

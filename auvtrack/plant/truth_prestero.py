@@ -38,7 +38,7 @@ def allocate(tau3, eta, nu, x, pp, prev, h, cmd):
 def rhs(t, x, att, cmd, env, pp, scr, fresh, dx):
     """dx[0:NX] = f(t, x, cmd) with the environment's disturbance forces and current."""
     dist, vc = environment(env[0], env[1], t, scr, fresh)
-    prestero.derivative(x, vc, dist, cmd, pp, dx)
+    prestero.derivative(x, att, vc, dist, cmd, pp, dx)
 
 
 @njit_noalloc
