@@ -354,3 +354,18 @@ def test_allocation_saturates_and_reports(name):
     # reverse thrust is produced by negative rpm
     bits, cmd, prod = _alloc(name, (-2.0, 0.0, 0.0), (0.0, 0.0, 0.0), pp)
     assert bits == 0 and cmd[CMD_N] < 0 and prod[0] == pytest.approx(-2.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("name", SHIPPED6)
+def test_trim_rpm_balances_surge(name):
+    from auvtrack.plant.truth6 import trim_rpm
+    pp = pack_truth(name)
+    n = trim_rpm(name, pp, 1.0)
+    x = initial_state(nu6=(1.0, 0, 0, 0, 0, 0), actuators=(0.0, 0.0, n))
+    M = np.linalg.inv(pp[P_MINV:P_MINV + 36].reshape(6, 6))
+    assert abs(M[0] @ _derivative(name, x, (0.0, 0.0, n), pp)[6:12]) < 1e-9  # surge force balance
+    assert trim_rpm(name, pp, 0.0) == 0.0
+    if name == "remus100_prestero":  # T = X_prop (n/n0)^2 = -X_u|u| u^2
+        assert n == pytest.approx(1500.0 * math.sqrt(1.62 / 3.86), rel=1e-9)
+    with pytest.raises(ValueError, match="initial.nu: surge speed u = 5 m/s needs more"):
+        trim_rpm(name, pp, 5.0)

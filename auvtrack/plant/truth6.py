@@ -15,7 +15,7 @@ import numpy as np
 
 from . import fossen_remus, prestero
 from .kinematics import attitude
-from .layout6 import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_NMAX, P_NRATE,
+from .layout6 import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_MINV, P_NMAX, P_NRATE,
                       P_TDELTA, P_TN, PP6_SIZE)
 from .presets6 import Preset6, load_preset6
 
@@ -72,6 +72,42 @@ def pack_truth(name: str, overrides: dict | None = None, direct: bool = False) -
         common[_SLOTS[k]] = x
     common[P_DIRECT] = 1.0 if direct else 0.0
     return MODELS[name].pack(pr, common)
+
+
+def trim_rpm(name: str, pp: np.ndarray, u: float) -> float:
+    """Propeller speed (rpm) at which straight, level running at surge speed u is in surge balance.
+
+    Solves X(u, n) = 0 for n by bisection on [0, n_max], X the surge component of the generalized
+    force M nu_dot (fins at zero, everything else at rest but u); 0 for u <= 0.  Used to start a
+    6-DOF run at speed with its propeller trimmed.
+
+    Raises
+    ------
+    ValueError
+        ``initial.nu: surge speed u needs more than n_max`` when u is out of the propeller's reach.
+    """
+    if u <= 0.0:
+        return 0.0
+    model = MODELS[name]
+    dx = np.zeros(NX6)
+    cmd = np.zeros(6)
+    att = attitude(0.0, 0.0)
+
+    M = np.linalg.inv(pp[P_MINV:P_MINV + 36].reshape(6, 6))
+
+    def accel(n):
+        x = initial_state(nu6=(u, 0, 0, 0, 0, 0), actuators=(0.0, 0.0, n))
+        cmd[2] = n
+        model.derivative(x, att, (0.0, 0.0, 0.0), (0.0,) * 6, cmd, pp, dx)
+        return float(M[0] @ dx[6:12])
+    lo, hi = 0.0, float(pp[P_NMAX])
+    if accel(hi) < 0.0:
+        raise ValueError(f"initial.nu: surge speed u = {u:g} m/s needs more than the propeller's "
+                         f"{hi:g} rpm (plant {name})")
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if accel(mid) < 0.0 else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def initial_state(eta6=(0.0,) * 6, nu6=(0.0,) * 6, actuators=(0.0, 0.0, 0.0)) -> np.ndarray:
