@@ -75,12 +75,13 @@ def environment(rows, current, t, scr, fresh):
 
 @njit_noalloc
 def direct_command(tau3, pp, cmd):
-    """Open-loop actuator commands: tau3 = (delta_r, delta_s, n) copied to cmd; bit j set if beyond its limit."""
-    cmd[CMD_DR], cmd[CMD_DS], cmd[CMD_N] = tau3[0], tau3[1], tau3[2]
+    """Open-loop actuator commands: tau3 = (n (rpm), delta_s, delta_r (rad)), in the order of the
+    channels they drive (surge, pitch, yaw), copied to cmd; bit j set if tau3[j] is beyond its limit."""
+    cmd[CMD_N], cmd[CMD_DS], cmd[CMD_DR] = tau3[0], tau3[1], tau3[2]
     cmd[CMD_TAU] = cmd[CMD_TAU + 1] = cmd[CMD_TAU + 2] = math.nan
     dm = pp[P_DMAX]
-    return ((1 if abs(tau3[2]) > pp[P_NMAX] else 0) | (2 if abs(tau3[1]) > dm else 0)
-            | (4 if abs(tau3[0]) > dm else 0))
+    return ((1 if abs(tau3[0]) > pp[P_NMAX] else 0) | (2 if abs(tau3[1]) > dm else 0)
+            | (4 if abs(tau3[2]) > dm else 0))
 
 
 @njit_noalloc
