@@ -75,8 +75,10 @@ def environment(rows, current, t, scr, fresh):
 
 @njit_noalloc
 def direct_command(tau3, pp, cmd):
-    """Open-loop actuator commands: tau3 = (n (rpm), delta_s, delta_r (rad)), in the order of the
-    channels they drive (surge, pitch, yaw), copied to cmd; bit j set if tau3[j] is beyond its limit."""
+    """Copy open-loop actuator commands tau3 = (n, delta_s, delta_r) to cmd; bit j set if beyond its limit.
+
+    The order is that of the channels they drive (surge, pitch, yaw); units rpm, rad, rad.
+    """
     cmd[CMD_N], cmd[CMD_DS], cmd[CMD_DR] = tau3[0], tau3[1], tau3[2]
     cmd[CMD_TAU] = cmd[CMD_TAU + 1] = cmd[CMD_TAU + 2] = math.nan
     dm = pp[P_DMAX]
