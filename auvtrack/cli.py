@@ -126,11 +126,13 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
 
 
 @cli.command()
-def warmup() -> None:
-    """Compile (or load from the cache) every kernel once."""
+@click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: every one).")
+@click.option("--plant", "plants", multiple=True, help="Plant model(s) (default: every one).")
+def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
+    """Compile every kernel (each controller on each plant) once, in parallel; later runs load them."""
     from .runner.bench import warmup as _warmup
 
-    click.echo(json.dumps(_warmup()))
+    click.echo(json.dumps(_warmup(controllers, plants, progress=True)))
 
 
 @cli.command()

@@ -105,45 +105,55 @@ def test_bad_arguments():
 
 def test_stage_reuse_of_reference_and_disturbance_is_exact(preps):
     """The engine reuses stage 2's reference and omega at stage 3 (same time): same numbers as fresh."""
-    from auvtrack.control.dispatch import WORK_SIZE
+    from auvtrack.control.contract import WORK_SIZE
     from auvtrack.environment.layout import KIND_CURRENT
+    from auvtrack.plant.contract import SCRATCH_SIZE
     from auvtrack.plant.kinematics import attitude
-    from auvtrack.simulation import engine
+    from auvtrack.simulation import engine, kernels
 
     p = preps[0]  # ftsmc, paper disturbance
-    assert engine.state_free_disturbance(p.d_rows)
-    rows = p.d_rows.copy()
+    rows0 = p.environment.rows
+    assert engine.state_free_disturbance(rows0)
+    rows = rows0.copy()
     rows[0, 0] = KIND_CURRENT
     assert not engine.state_free_disturbance(rows)
-    nx, t = p.X0.size, 0.3705
-    code = int(p.si[engine.SI_CODE])
+    stage = kernels.kernel_module(p.key).stage
+    t, nxp, nxc = 0.3705, p.plant.x0.size, p.controller.x0.size
 
-    def call(X, fresh, refm, omega):
-        dX, tau, aux, work = np.zeros(nx), np.zeros(3), np.zeros(3), np.zeros(WORK_SIZE)
-        st = engine.closed_loop_rhs(code, t, X, 0, nx, p.cp, p.vp_nom, p.vp_true, p.ref_p, p.d_rows, p.d_cur,
-                                    np.zeros(3), dX, tau, aux, refm, omega, work, attitude(X[3], X[4]), fresh, p.sf)
+    def call(xp, fresh, sk):
+        refm, scr = sk
+        dxp, dxc, tau, aux, cmd = np.zeros(nxp), np.zeros(nxc), np.zeros(3), np.zeros(3), np.zeros(3)
+        st, _ = stage(t, xp, p.controller.x0, attitude(xp[3], xp[4]), 0, p.cp, p.vp_nom, p.pp, p.ref_p, rows0,
+                      p.environment.current, refm, np.zeros(WORK_SIZE), scr, cmd, dxp, dxc, tau, aux, fresh)
         assert st == 0
-        return dX, tau
+        return dxp, tau
 
-    Xa = p.X0 + 0.01
-    Xb = p.X0 - 0.02
-    refm, omega = np.zeros((3, 3)), np.zeros(5)
-    call(Xa, True, refm, omega)
-    reused = call(Xb, False, refm, omega)
-    fresh = call(Xb, True, np.zeros((3, 3)), np.zeros(5))
+    def scratch():
+        return np.zeros((3, 3)), np.zeros(SCRATCH_SIZE)
+
+    xa, xb = p.plant.x0 + 0.01, p.plant.x0 - 0.02
+    sk = scratch()
+    call(xa, True, sk)
+    reused = call(xb, False, sk)
+    fresh = call(xb, True, scratch())
     np.testing.assert_array_equal(reused[0], fresh[0])
     np.testing.assert_array_equal(reused[1], fresh[1])
 
 
-def test_state_check_precedence():
-    """One-pass state check: non-finite before pitch before state limit."""
-    from auvtrack.simulation import engine
+def test_state_check_precedence(preps):
+    """One-pass state check over plant and controller states: non-finite before pitch before state limit."""
+    from auvtrack.simulation import engine, kernels
 
-    X = np.zeros(12)
-    assert engine._state_cause(X, 1.0, 10.0) == engine.CAUSE_NONE
-    X[3], X[7] = 2.0, 50.0
-    assert engine._state_cause(X, 1.0, 10.0) == engine.CAUSE_PITCH
-    X[11] = np.inf
-    assert engine._state_cause(X, 1.0, 10.0) == engine.CAUSE_NONFINITE
-    X[3], X[11] = 0.5, 0.0
-    assert engine._state_cause(X, 1.0, 10.0) == engine.CAUSE_STATE_LIMIT
+    state_cause = kernels.kernel_module(preps[0].key).state_cause
+    sf = np.zeros(engine.SF_SIZE)
+    sf[engine.SF_THETA_LIM], sf[engine.SF_STATE_LIM] = 1.0, 10.0
+    xp, xc = np.zeros(10), np.zeros(2)
+    assert state_cause(xp, xc, sf) == engine.CAUSE_NONE
+    xp[3], xp[7] = 2.0, 50.0
+    assert state_cause(xp, xc, sf) == engine.CAUSE_PITCH
+    xc[1] = np.inf
+    assert state_cause(xp, xc, sf) == engine.CAUSE_NONFINITE
+    xp[3], xc[1] = 0.5, 0.0
+    assert state_cause(xp, xc, sf) == engine.CAUSE_STATE_LIMIT
+    xp[7], xc[0] = 0.0, -11.0
+    assert state_cause(xp, xc, sf) == engine.CAUSE_STATE_LIMIT

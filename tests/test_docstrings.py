@@ -2,7 +2,7 @@
 
 Every public function and class of every module has a docstring with a one-line summary; the
 user-facing API documents every parameter and its return value.  Compiled kernels share the
-argument contract written once in their module docstring (e.g. :mod:`auvtrack.control.dispatch`),
+argument contract written once in their module docstring (e.g. :mod:`auvtrack.control.contract`),
 so only the summary rules apply to them.
 """
 import importlib
@@ -32,6 +32,14 @@ API = [
     "auvtrack.control.theory.lemma1_residual",
     "auvtrack.control.registry.register",
     "auvtrack.control.registry.get",
+    "auvtrack.control.registry.ControllerSpec.from_module",
+    "auvtrack.plant.registry.register",
+    "auvtrack.plant.registry.get",
+    "auvtrack.plant.registry.PlantSpec.from_module",
+    "auvtrack.simulation.kernels.kernel",
+    "auvtrack.simulation.kernels.warmup",
+    "auvtrack.simulation.kernels.law_module",
+    "auvtrack.runner.batch.run_batch",
     "auvtrack.reference.build_reference",
     "auvtrack.environment.build_disturbance",
     "auvtrack.plant.presets.get_preset",

@@ -234,7 +234,7 @@ def test_reaching_law_is_eq32(S, k1, k2, k3):
 
 def test_the_network_may_fill_the_whole_scratch_array():
     """The basis of eq. (12) is written to work[0:m], m up to WORK_SIZE, eight neurons per vector exp."""
-    from auvtrack.control.dispatch import WORK_SIZE
+    from auvtrack.control.contract import WORK_SIZE
 
     res = _quiet(PAPER, [f"estimator.neurons={WORK_SIZE}", "sim.duration=0.05"])
     assert res.ok and np.isfinite(res["chi_hat_x"]).all()

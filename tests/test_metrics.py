@@ -46,12 +46,12 @@ def signals(t, e_fn, tau_fn=None):
 
 # ------------------------------------------------------------------ structure
 def test_names_and_size():
-    assert len(METRIC_NAMES) == 30 and len(set(METRIC_NAMES)) == 30
+    assert len(METRIC_NAMES) == 33 and len(set(METRIC_NAMES)) == 33
     for a in "xyz":
         for k in ("rmse", "iae", "itae", "max_abs", "settle_5cm", "settle_1cm", "settle_1mm"):
             assert f"{k}_{a}" in METRIC_NAMES
     for j in "uqr":
-        for k in ("max_abs_tau", "energy_tau", "tv_tau"):
+        for k in ("max_abs_tau", "energy_tau", "tv_tau", "t_sat_tau"):
             assert f"{k}_{j}" in METRIC_NAMES
     acc = np.full(METRICS_SIZE, 7.0)
     metrics_init(acc)

@@ -61,9 +61,9 @@ def test_noise_is_seeded_scaled_and_independent_per_channel():
 def test_measure_adds_row_k_and_nothing_without_noise():
     X = np.arange(12.0)
     noise = noise_table(3, 5, np.full(10, 0.5))
-    eta, nu = measure(X, noise, 2)
+    eta, nu = measure(tuple(X[:5]), tuple(X[5:10]), noise, 2)
     np.testing.assert_array_equal(np.array(eta + nu), X[:10] + noise[2])
-    eta, nu = measure(X, np.zeros((0, 10)), 2)
+    eta, nu = measure(tuple(X[:5]), tuple(X[5:10]), np.zeros((0, 10)), 2)
     np.testing.assert_array_equal(np.array(eta + nu), X[:10])
 
 
@@ -173,24 +173,26 @@ def test_actuator_limits_broadcast_round_trip_and_refuse_non_positive():
 @pytest.mark.parametrize("kind", ["ftsmc", "fxtntsmc"])
 def test_sampled_law_uses_the_attitude_of_the_measured_state(kind):
     """The engine hands the law attitude(measured theta, psi), not that of the true state."""
-    from auvtrack.control.dispatch import WORK_SIZE, control
+    from auvtrack.control.contract import WORK_SIZE
     from auvtrack.plant.kinematics import attitude
     from auvtrack.scenario import load_scenario
     from auvtrack.simulation.api import prepare, run_prepared
-    from auvtrack.simulation.engine import SI_CODE
+    from auvtrack.simulation.kernels import law_module
 
     sc = load_scenario({}, ["sim.duration=0.05", "sim.control_rate=100", f"controller.kind={kind}",
                             "sensor.sigma_eta=[0, 0, 0, 0.05, 0.05]"])
     p = prepare(sc)
     first = run_prepared(p).to_pandas().iloc[0]  # the input applied on [0, 10 ms) is the law at sample 0
-    eta, nu = measure(p.X0, p.noise, 0)
+    x0 = p.plant.x0
+    eta, nu = measure(tuple(x0[:5]), tuple(x0[5:10]), p.noise, 0)
+    control = law_module(p.key.law).control
 
     def law(att):
-        tau, dX, aux, work = np.zeros(3), np.zeros(p.X0.size), np.zeros(64), np.zeros(WORK_SIZE)
-        assert control(int(p.si[SI_CODE]), 0.0, eta, nu, att, p.X0, _ref0(p), p.vp_nom, p.cp, tau, dX, aux, work) == 0
+        tau, dxc, aux, work = np.zeros(3), np.zeros(p.controller.x0.size), np.zeros(64), np.zeros(WORK_SIZE)
+        assert control(0.0, eta, nu, att, p.controller.x0, _ref0(p), p.vp_nom, p.cp, tau, dxc, aux, work) == 0
         return tau
 
-    measured, true = law(attitude(eta[3], eta[4])), law(attitude(p.X0[3], p.X0[4]))
+    measured, true = law(attitude(eta[3], eta[4])), law(attitude(x0[3], x0[4]))
     applied = first[["tau_u", "tau_q", "tau_r"]].to_numpy(float)
     np.testing.assert_array_equal(applied, measured)
     assert np.abs(measured - true).max() > 1e-6 * np.abs(measured).max()  # the test can tell them apart

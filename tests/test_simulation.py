@@ -111,9 +111,9 @@ def test_metrics_match_the_reference_implementation_when_logging_every_step():
 def test_uncertainty_changes_only_the_true_plant():
     sc = load_scenario(PAPER, ["uncertainty.M=0.2", "uncertainty.C=0.3", "uncertainty.D=-0.1"])
     p = prepare(sc)
-    np.testing.assert_allclose(p.vp_true[0:5], 1.2 * p.vp_nom[0:5])
-    np.testing.assert_allclose(p.vp_true[5:10], 0.9 * p.vp_nom[5:10])
-    assert p.vp_true[12] == pytest.approx(1.3) and p.vp_nom[12] == 1.0
+    np.testing.assert_allclose(p.pp[0:5], 1.2 * p.vp_nom[0:5])
+    np.testing.assert_allclose(p.pp[5:10], 0.9 * p.vp_nom[5:10])
+    assert p.pp[12] == pytest.approx(1.3) and p.vp_nom[12] == 1.0
 
 
 def test_true_lumped_disturbance_vanishes_on_the_nominal_plant():

@@ -1,14 +1,18 @@
-"""Controllers: registry, shared tracking kinematics and the compiled laws."""
+"""Controllers: registry, shared tracking kinematics and the compiled laws.
+
+Registering a built-in controller is one line: its module in :data:`BUILTIN`.
+"""
 from . import ftsmc, fxtntsmc, open_loop
 from .params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
-from .registry import CONTROLLERS, CompiledController, ControllerSpec, get, register
+from .registry import CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, get, register
 
-register(ControllerSpec("ftsmc", ftsmc.CODE, FTSMCParams, ftsmc.setup,
-                        "nonsingular terminal SMC baseline (ERRATA 16)"))
-register(ControllerSpec("fxtntsmc", fxtntsmc.CODE, FXTNTSMCParams, fxtntsmc.setup,
-                        "the paper's FXTNTSMC with flexible prescribed performance and RBF network"))
-register(ControllerSpec("open_loop", open_loop.CODE, OpenLoopParams, open_loop.setup,
-                        "open-loop sinusoidal input (plant checks)"))
+BUILTIN = (
+    fxtntsmc,
+    ftsmc,
+    open_loop,
+)
+for _module in BUILTIN:
+    register(ControllerSpec.from_module(_module))
 
-__all__ = ["CONTROLLERS", "CompiledController", "ControllerSpec", "get", "register",
-           "FTSMCParams", "FXTNTSMCParams"]
+__all__ = ["BUILTIN", "CONTROLLERS", "CompiledController", "ControllerParams", "ControllerSpec", "get",
+           "register", "FTSMCParams", "FXTNTSMCParams", "OpenLoopParams"]

@@ -14,15 +14,36 @@ Packed parameters ``cp`` = [beta, gamma, k1, k2]; no internal state; logged aux:
 """
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
+from pydantic import Field
 
 from .._jit import njit, njit_noalloc
-from .params import FTSMCParams
-from .registry import CompiledController
+from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
 
-CODE = 1
+NAME = "ftsmc"
 AUX_NAMES = ("s_x", "s_y", "s_z")
+
+
+class Params(ControllerParams):
+    """Nonsingular terminal SMC baseline (ERRATA 16).
+
+    ``s = e + beta * sig^gamma(e_dot)`` with ``gamma = p/q`` in (1, 2); reaching law
+    ``e_ddot = -(1/(beta*gamma)) sig^(2-gamma)(e_dot) - k1 sign(s) - k2 s``.
+    The defaults are hand-picked gains that predate the recorded tuning procedure; the gains
+    found by that procedure are the gain preset ``ftsmc_tuned`` (scenario key
+    ``controller.preset``, expanded into these fields when the scenario is loaded), see
+    ``docs/tuning.md`` for how the two compare.
+    """
+
+    kind: Literal["ftsmc"] = "ftsmc"
+    beta: float = Field(1.0, gt=0, description="weight of the terminal term, s^gamma")
+    gamma: float = Field(1.5, gt=1, lt=2, description="terminal exponent p/q, in (1, 2)")
+    k1: float = Field(0.05, ge=0, description="switching gain, m/s^2")
+    k2: float = Field(1.0, ge=0, description="linear reaching gain, 1/s")
+
 
 
 @njit
@@ -33,8 +54,8 @@ def reaching(e, ed, beta, gam, k1, k2):
     return s, -s2g / (beta * gam) - k1 * sign(s) - k2 * s
 
 
-@njit_noalloc(inline="always")  # one function with dispatch.control for LLVM (docs/architecture.md)
-def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
+@njit_noalloc(inline="always")  # one function with the engine for LLVM (docs/architecture.md)
+def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
     """Compiled FTSMC law; returns status 0 (it has no failure modes of its own)."""
     e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
     s0, a0 = reaching(e[0], ed[0], cp[0], cp[1], cp[2], cp[3])
@@ -47,6 +68,6 @@ def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
 
 def setup(scenario, ctx) -> CompiledController:
     """Pack the FTSMC gains of ``scenario.controller``."""
-    p: FTSMCParams = scenario.controller
+    p: Params = scenario.controller
     cp = np.array([p.beta, p.gamma, p.k1, p.k2], dtype=np.float64)
-    return CompiledController(code=CODE, cp=cp, xc0=np.zeros(0), aux_names=AUX_NAMES)
+    return CompiledController(cp=cp, xc0=np.zeros(0), aux_names=AUX_NAMES)

@@ -25,16 +25,19 @@ z (transformed error).
 from __future__ import annotations
 
 
+from typing import Literal
+
 import numpy as np
+from pydantic import Field
 
 from .._jit import njit, njit_noalloc
 from .._vecmath import atanh4, pow4
 from . import envelopes, rbf
-from .registry import CompiledController
-from .dispatch_layout import NX_PLANT, WORK_SIZE
+from .registry import CompiledController, ControllerParams
+from .contract import WORK_SIZE
 from .tracking import error_state_forces, input_for_accel_forces, sign
 
-CODE = 2
+NAME = "fxtntsmc"
 AXES = ("x", "y", "z")
 AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "S", "g", "z") for a in AXES)
 
@@ -49,8 +52,36 @@ ENV, EP0 = 12, 13  # envelope kind, then the 14 envelope parameters of envelopes
 SC1, SC2, SB1, SB2 = 27, 28, 29, 30
 EST, NEUR, WIDTH, CENT = 31, 32, 33, 34
 SURFACES = {"nonsingular": 0, "printed": 1}
-XC = NX_PLANT  # internal state [rho_bar (3), W (3 m)] starts here in X
+RHO_BAR, WEIGHTS = 0, 3  # internal state xc = [rho_bar (3), W (3 m)]
 MAX_NEURONS = WORK_SIZE  # the basis psi occupies work[0:m]
+
+
+class Params(ControllerParams):
+    """Fixed-time nonsingular terminal SMC of the paper (eq. 26-32, corrected per ERRATA 11-13).
+
+    Names follow the paper: ``a3 = b1`` and ``a4 = b2`` (ERRATA 11); ``varsigma1`` is the
+    approximation-error bound written "zeta1 = 0.05" in Section 4.
+    """
+
+    kind: Literal["fxtntsmc"] = "fxtntsmc"
+    kappa1: float = Field(0.005, gt=0, description="switching gain")
+    kappa2: float = Field(0.8, gt=0, description="cubic reaching gain")
+    kappa3: float = Field(0.6, gt=0, description="linear reaching gain")
+    a1: float = Field(0.8, gt=0)
+    a2: float = Field(0.8, gt=0, lt=1, description="fractional power, 0.5 <= a2 < 1 in Theorem 1")
+    a3: float = Field(0.8, gt=0, description="b1 of Theorem 1")
+    a4: float = Field(2.0, gt=1, description="b2 of Theorem 1")
+    alpha: float = Field(0.6, gt=0)
+    sigma: float = Field(0.005, gt=0, description="switch threshold of eq. (27)")
+    varsigma1: float = Field(0.05, gt=0, description="RBF approximation-error bound (Theorem 1)")
+    surface: Literal["nonsingular", "printed"] = Field(
+        "nonsingular",
+        description="'nonsingular': C1 switch on |z| replaces sig^a2 near 0 (ERRATA 12); "
+        "'printed': eq. (28) as printed, with |z| floored at z_floor",
+    )
+    z_switch: float = Field(0.01, gt=0, description="|z| below which the nonsingular switch is used")
+    z_floor: float = Field(1e-6, gt=0, description="floor on |z| in the printed form's |z|^(a2-1)")
+
 
 
 class StartOutsideEnvelope(ValueError):
@@ -193,17 +224,17 @@ def reaching_law(S, k1, k2, k3):
 
 
 @njit_noalloc(inline="always")
-def _transform(kind, shape, cp, eprm, e, ed, X, i):
+def _transform(kind, shape, cp, eprm, e, ed, xc, i):
     """Envelope and error transformation of axis ``i`` (eq. 17-25) with xi for z, :func:`envelopes.axis_transform_xi`."""
     r1 = envelopes.axis_baseline(shape, cp, EP0, i)
-    return envelopes.axis_transform_xi(kind, e[i], ed[i], X[XC + i], eprm, r1)
+    return envelopes.axis_transform_xi(kind, e[i], ed[i], xc[RHO_BAR + i], eprm, r1)
 
 
 @njit_noalloc(inline="always")
-def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dX, aux):
+def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux):
     """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27) and the commanded e_ddot (eq. 32, ERRATA 13).
 
-    Returns (S (m/s), e_ddot (m/s^2), Omega_i); writes dX of rho_bar_i and the aux channels except
+    Returns (S (m/s), e_ddot (m/s^2), Omega_i); writes dxc of rho_bar_i and the aux channels except
     chi_hat, which the estimator's update of the three axes fills in afterwards.
     """
     _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
@@ -211,13 +242,13 @@ def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dX, aux):
     S = zd + s1
     reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
     edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / (Om - c1)
-    dX[XC + i] = rbd
+    dxc[RHO_BAR + i] = rbd
     aux[i], aux[3 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, S, g, z
     return S, edd, Om
 
 
 @njit_noalloc(inline="always")
-def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
+def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
     """Compiled FXTNTSMC law, eq. (26)-(34) corrected (tau in N, N m); status 1 if an error leaves its envelope.
 
     ``work[0:m]`` holds the RBF basis.
@@ -233,13 +264,13 @@ def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
         shape = envelopes.baseline_shape(t, cp[EP0 + envelopes.EP_T])
     eprm = envelopes.params(cp, EP0)
     # three phases over the axes, so that atanh (eq. 17) and each power of eq. (27)-(28) is one vector call
-    st0, tr0 = _transform(kind, shape, cp, eprm, e, ed, X, 0)
+    st0, tr0 = _transform(kind, shape, cp, eprm, e, ed, xc, 0)
     if st0 != 0:
         return st0
-    st1, tr1 = _transform(kind, shape, cp, eprm, e, ed, X, 1)
+    st1, tr1 = _transform(kind, shape, cp, eprm, e, ed, xc, 1)
     if st1 != 0:
         return st1
-    st2, tr2 = _transform(kind, shape, cp, eprm, e, ed, X, 2)
+    st2, tr2 = _transform(kind, shape, cp, eprm, e, ed, xc, 2)
     if st2 != 0:
         return st2
     xi = (tr0[0], tr1[0], tr2[0])  # e / rho, or e itself without an envelope (then z = e)
@@ -257,13 +288,13 @@ def control(t, eta, nu, att, X, refm, vp, cp, tau, dX, aux, work):
     se2, dse2 = surface_q(z[2], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[2])
     ase = (abs(se0), abs(se1), abs(se2))
     qs = powers_below3(ase, cp[ALPHA], (ase[0] > cp[SIGMA], ase[1] > cp[SIGMA], ase[2] > cp[SIGMA]))
-    S0, edd0, om0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dX, aux)
-    S1, edd1, om1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dX, aux)
-    S2, edd2, om2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dX, aux)
+    S0, edd0, om0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux)
+    S1, edd1, om1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux)
+    S2, edd2, om2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux)
     chat = (0.0, 0.0, 0.0)
     if est != rbf.NONE:
         gain = (om0, om1, om2) if est == rbf.OMEGA else (1.0, 1.0, 1.0)
-        chat = rbf.estimate_and_adapt3(X, XC + 3, m, work, (S0, S1, S2), gain, dX)
+        chat = rbf.estimate_and_adapt3(xc, WEIGHTS, m, work, (S0, S1, S2), gain, dxc)
     aux[6], aux[7], aux[8] = chat
     acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])
     tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, acc, gf)
@@ -322,5 +353,5 @@ def setup(scenario, ctx) -> CompiledController:
     assert cp.size == CENT + 6 * m and cp[EST] == rbf.ESTIMATORS[est.kind]
     xc0 = np.concatenate([rb0, weights.ravel()])
     resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
-    return CompiledController(code=CODE, cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),
+    return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),
                               resolved=resolved)

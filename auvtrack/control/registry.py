@@ -1,24 +1,34 @@
 """Controller registry.
 
-A controller is one module that defines
+A controller is one module (the contract is in :mod:`auvtrack.control.contract`) that defines
 
-* a pydantic ``Params`` model for its ``[controller]`` scenario section (with ``kind``),
-* a compiled ``control(...)`` function (the signature is documented in
-  :mod:`auvtrack.control.dispatch`), and
-* a ``setup(scenario, ctx)`` function returning a :class:`CompiledController`,
+* ``NAME``, the scenario's ``controller.kind``, and ``AUX_NAMES``, its logged channels;
+* ``Params``, the pydantic model of its ``[controller]`` section (``kind: Literal[NAME]``);
+* the compiled law ``control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work) -> status``;
+* ``setup(scenario, ctx) -> CompiledController``, which packs its gains and initial state and
+  checks its gain conditions;
+* optionally ``STATUS = {code: message}`` for its own failure codes.
 
-and registers itself here with a unique integer ``code``.  Adding a controller means one new
-file, one ``register`` call (in :mod:`auvtrack.control`), one branch in
-:mod:`auvtrack.control.dispatch` and one in :func:`auvtrack.simulation.engine.run_kernel`
-(compiled code cannot look functions up at run time), plus its parameter model.
+Registering a built-in controller is one line in :mod:`auvtrack.control` (its module in the
+``BUILTIN`` tuple).  The engine's kernel for a (controller, plant) pair is generated and compiled
+on demand (:mod:`auvtrack.simulation.kernels`), so no code elsewhere names a controller.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import ModuleType
 from typing import Any, Callable
 
 import numpy as np
-from pydantic import BaseModel
+from pydantic import BaseModel, ConfigDict
+
+CONTRACT = ("NAME", "AUX_NAMES", "Params", "control", "setup")
+
+
+class ControllerParams(BaseModel):
+    """Base of every controller's ``Params``: frozen, unknown keys refused."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 @dataclass(frozen=True)
@@ -27,37 +37,81 @@ class CompiledController:
 
     Attributes
     ----------
-    code : int
-        Dispatch code of the controller (see :mod:`auvtrack.control.dispatch`).
     cp : numpy.ndarray
         Packed float64 parameters.
     xc0 : numpy.ndarray
-        Initial internal state (adaptive weights, envelope filters); may be empty.
+        Initial internal state (adaptive weights, envelope filters, integrators); may be empty.
     aux_names : tuple of str
         Names of the extra logged channels the controller writes (``rho_x``, ``S_x``, ...).
     notes : tuple of str
         Warnings to show the user (e.g. an initial envelope widening).
     resolved : dict
         Derived values worth recording in ``run.json``.
+    law : str
+        Where the compiled ``control`` lives: an importable module name or a ``.py`` file path.
+        Empty: the registered module's (plug-ins set it to their file).
     """
 
-    code: int
     cp: np.ndarray
     xc0: np.ndarray
     aux_names: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
     resolved: dict[str, Any] = field(default_factory=dict)
+    law: str = ""
 
 
 @dataclass(frozen=True)
 class ControllerSpec:
-    """Registration record of one controller."""
+    """Registration record of one controller.
+
+    Attributes
+    ----------
+    name : str
+        ``controller.kind``.
+    module : str
+        Importable name of the module holding the compiled ``control``.
+    params : type
+        Its pydantic ``Params`` model.
+    setup : callable
+        ``setup(scenario, ctx) -> CompiledController``.
+    summary : str
+        One line for listings (the module docstring's first line).
+    statuses : dict of int to str
+        Messages of the controller's own status codes.
+    """
 
     name: str
-    code: int
+    module: str
     params: type[BaseModel]
     setup: Callable[..., CompiledController]
     summary: str = ""
+    statuses: dict[int, str] = field(default_factory=dict)
+
+    @classmethod
+    def from_module(cls, module: ModuleType) -> "ControllerSpec":
+        """Build the record from a controller module.
+
+        Parameters
+        ----------
+        module : module
+            Defines every name of :data:`CONTRACT` (and optionally ``STATUS``).
+
+        Returns
+        -------
+        ControllerSpec
+            The record.
+
+        Raises
+        ------
+        TypeError
+            If a name of the contract is missing.
+        """
+        missing = [n for n in CONTRACT if not hasattr(module, n)]
+        if missing:
+            raise TypeError(f"controller module {module.__name__} lacks {', '.join(missing)}")
+        doc = (module.__doc__ or "").strip()
+        return cls(module.NAME, module.__name__, module.Params, module.setup,
+                   doc.splitlines()[0] if doc else "", dict(getattr(module, "STATUS", {})))
 
 
 CONTROLLERS: dict[str, ControllerSpec] = {}
@@ -69,7 +123,7 @@ def register(spec: ControllerSpec) -> ControllerSpec:
     Parameters
     ----------
     spec : ControllerSpec
-        The registration record; its name and code must be unused.
+        The registration record; its name must be unused.
 
     Returns
     -------
@@ -79,10 +133,10 @@ def register(spec: ControllerSpec) -> ControllerSpec:
     Raises
     ------
     ValueError
-        If the name or the code is already registered.
+        If the name is already registered.
     """
-    if spec.name in CONTROLLERS or any(s.code == spec.code for s in CONTROLLERS.values()):
-        raise ValueError(f"controller {spec.name!r} (code {spec.code}) is already registered")
+    if spec.name in CONTROLLERS:
+        raise ValueError(f"controller {spec.name!r} is already registered")
     CONTROLLERS[spec.name] = spec
     return spec
 

@@ -60,10 +60,13 @@ def noise_table(seed: int, n_samples: int, sigma) -> np.ndarray:
 
 
 @njit_noalloc
-def measure(X, noise, k):
-    """Measured (eta, nu) 5-tuples at control sample ``k`` (row ``k`` of ``noise``; no rows: exact)."""
+def measure(eta, nu, noise, k):
+    """The controller's view at control sample ``k``: the true (eta, nu) 5-tuples plus row ``k`` of ``noise``.
+
+    With a noise table of no rows (every sigma zero) the measurement is exact.
+    """
     if noise.shape[0] == 0:
-        return (X[0], X[1], X[2], X[3], X[4]), (X[5], X[6], X[7], X[8], X[9])
+        return eta, nu
     n = noise
-    return ((X[0] + n[k, 0], X[1] + n[k, 1], X[2] + n[k, 2], X[3] + n[k, 3], X[4] + n[k, 4]),
-            (X[5] + n[k, 5], X[6] + n[k, 6], X[7] + n[k, 7], X[8] + n[k, 8], X[9] + n[k, 9]))
+    return ((eta[0] + n[k, 0], eta[1] + n[k, 1], eta[2] + n[k, 2], eta[3] + n[k, 3], eta[4] + n[k, 4]),
+            (nu[0] + n[k, 5], nu[1] + n[k, 6], nu[2] + n[k, 7], nu[3] + n[k, 8], nu[4] + n[k, 9]))

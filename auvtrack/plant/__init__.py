@@ -1,1 +1,10 @@
-"""plant."""
+"""Plants: vehicle models (kinematics, kinetics, presets), actuators, and the registry of truth models.
+
+Registering a plant is one line here: ``register(PlantSpec.from_module(module))``.
+"""
+from . import five_dof
+from .registry import PLANTS, CompiledPlant, PlantSpec, get, register
+
+register(PlantSpec.from_module(five_dof))
+
+__all__ = ["PLANTS", "CompiledPlant", "PlantSpec", "get", "register"]

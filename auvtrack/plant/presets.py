@@ -142,3 +142,35 @@ def pack_vehicle(m, d, wgml: float, l: float, c_scale: float = 1.0) -> np.ndarra
     vp[ELL] = l
     vp[CSCALE] = c_scale
     return vp
+
+
+def vehicle_arrays(sc) -> tuple[np.ndarray, np.ndarray, dict]:
+    """Nominal and true packed 5-DOF vehicles of a scenario, and their record.
+
+    Parameters
+    ----------
+    sc : Scenario
+        A validated scenario: ``[vehicle]`` (preset and overrides) and ``[uncertainty]``.
+
+    Returns
+    -------
+    vp_nom, vp_true : numpy.ndarray
+        Packed vehicles (:mod:`auvtrack.plant.params`): the nominal one that controllers use, and
+        the true one with the uncertainty applied (M, D, G scaled by 1 + Delta, C by 1 + Delta C).
+    record : dict
+        Preset, numbers, sources and the true plant's numbers, for ``run.json``.
+    """
+    pre = get_preset(sc.vehicle.preset)
+    v = sc.vehicle
+    m = np.array(v.m if v.m is not None else pre.m, dtype=float)
+    d = np.array(v.d if v.d is not None else pre.d, dtype=float)
+    wgml = float(v.wgml if v.wgml is not None else pre.wgml)
+    ell = float(v.l if v.l is not None else pre.l)
+    u = sc.uncertainty
+    vp_nom = pack_vehicle(m, d, wgml, ell, 1.0)
+    vp_true = pack_vehicle(m * (1 + u.M), d * (1 + u.D), wgml * (1 + u.G), ell, 1.0 + u.C)
+    record = {"preset": pre.name, "m": m.tolist(), "d": d.tolist(), "wgml": wgml, "l": ell,
+              "sources": pre.sources,
+              "true_plant": {"m": (m * (1 + u.M)).tolist(), "d": (d * (1 + u.D)).tolist(),
+                             "wgml": wgml * (1 + u.G), "c_scale": 1.0 + u.C}}
+    return vp_nom, vp_true, record

@@ -1,9 +1,9 @@
 """Batch runner: many prepared scenarios per call, parallel over cores, reduced to metrics in-kernel.
 
-Each run calls the same compiled :func:`auvtrack.simulation.engine.run_kernel` as
+Each run calls the same compiled kernel of its (controller, plant) pair as
 :func:`auvtrack.simulation.api.run_prepared`, with the same arrays, so a batch result is
 bit-identical to the single-run result of the same scenario.  By default a run keeps no
-trajectory: the kernel gets a 0-row log and only its metrics accumulator (46 floats), cause,
+trajectory: the kernel gets a 0-row log and only its metrics accumulator (49 floats), cause,
 stop time and failure state come back, so memory does not grow with the length of a run, and
 :func:`iter_batch` keeps it flat in the number of runs too (it prepares and runs lazily, one
 block at a time).
@@ -13,7 +13,7 @@ Two parallel back ends (measured in ``benchmarks/results.md``):
 * ``"threads"`` (default): a thread pool over the ``nogil`` kernel; the arrays of each run are
   passed as they are, so scenarios of any shape can be mixed.
 * ``"prange"``: one compiled ``numba.prange`` loop over runs of identical array shapes
-  (:func:`batch_kernel`), grouped automatically.  About 1.4-1.8x serial on 2 cores, like the threads
+  (the kernel's ``run_many``), grouped automatically.  About 1.4-1.8x serial on 2 cores, like the threads
   (``benchmarks/results.md``), but never call it from several Python threads at once:
   Numba's default ``workqueue`` threading layer is not re-entrant and aborts the process.
 """
@@ -21,23 +21,25 @@ from __future__ import annotations
 
 import math
 import os
+import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
-import numba
 import numpy as np
 
-from .._jit import njit
-from ..simulation import engine
-from ..simulation.api import Prepared, _failure, run_prepared
+from ..simulation import engine, kernels
+from ..simulation.api import (Prepared, call_kernel, ensure_compiled, failure_record, outputs_for, result_from,
+                              status_of)
+from ..simulation.engine import Outputs
 from ..simulation.metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from ..simulation.result import Result
 
 BACKENDS = ("threads", "prange", "serial")
 
-__all__ = ["RunSummary", "run_metrics", "run_batch", "iter_batch", "batch_kernel", "BACKENDS",
-           "default_workers"]
+__all__ = ["RunSummary", "run_metrics", "run_batch", "iter_batch", "BACKENDS", "default_workers", "StopSignal",
+           "BatchInterrupted"]
 
 
 @dataclass(frozen=True)
@@ -47,7 +49,7 @@ class RunSummary:
     Attributes
     ----------
     status : str
-        ``"ok"`` or ``"failed"`` (as :attr:`auvtrack.simulation.result.Result.status`).
+        ``"ok"``, ``"failed"`` or ``"interrupted"`` (as :attr:`auvtrack.simulation.result.Result.status`).
     failure : dict or None
         Time, cause, detail and state of a failure (as ``Result.failure``).
     metrics : dict of str to float
@@ -56,7 +58,7 @@ class RunSummary:
     t_stop : float
         Simulated time at the stop (s).
     steps : int
-        Number of RK4 steps requested.
+        Number of RK4 steps actually run.
     """
 
     status: str
@@ -79,61 +81,96 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def _summary(prep: Prepared, cause: int, t_stop: float, acc: np.ndarray, fail_state: np.ndarray) -> RunSummary:
-    failure = None if cause == engine.CAUSE_NONE else _failure(int(cause), float(t_stop), fail_state, prep)
+class StopSignal:
+    """A stop request shared by the runs of a batch: :meth:`set` stops every run in flight and to come.
+
+    Each run registers its kernel's ``info`` array; the kernel reads its stop flag every 1024 steps.
+    """
+
+    def __init__(self) -> None:
+        self._infos: list[np.ndarray] = []
+        self._lock = threading.Lock()
+        self.is_set = False
+
+    def register(self, info: np.ndarray) -> None:
+        """Attach one run's ``info`` array (flagged at once if the signal is already set)."""
+        with self._lock:
+            self._infos.append(info)
+            if self.is_set:
+                info[..., engine.INFO_STOP] = 1
+
+    def set(self) -> None:
+        """Ask every registered (and later) run to stop."""
+        with self._lock:
+            self.is_set = True
+            for info in self._infos:
+                info[..., engine.INFO_STOP] = 1
+
+
+class BatchInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a batch; ``results`` holds every run's outcome (``"interrupted"`` for those cut short).
+
+    Attributes
+    ----------
+    results : list
+        One :class:`RunSummary` (or :class:`~auvtrack.simulation.result.Result`) per input, in order.
+    """
+
+    def __init__(self, results: list) -> None:
+        super().__init__("batch interrupted")
+        self.results = results
+
+
+def _summary(prep: Prepared, cause: int, t_stop: float, out: Outputs) -> RunSummary:
+    failure = None if cause == engine.CAUSE_NONE else failure_record(int(cause), float(t_stop), out.fail_state, prep)
     t0, t1 = prep.scenario.metrics.window
-    metrics = metrics_finalize(acc, t0, min(t1, float(t_stop)))
-    return RunSummary("ok" if failure is None else "failed", failure, metrics, float(t_stop),
-                      int(prep.si[engine.SI_NSTEPS]))
+    metrics = metrics_finalize(out.acc, t0, min(t1, float(t_stop)))
+    return RunSummary(status_of(int(cause)), failure, metrics, float(t_stop), int(out.info[engine.INFO_STEPS]))
 
 
-def run_metrics(prep: Prepared) -> RunSummary:
+def run_metrics(prep: Prepared, stop: StopSignal | None = None) -> RunSummary:
     """Run one prepared scenario without logging and return its :class:`RunSummary`.
 
     Parameters
     ----------
     prep : Prepared
         From :func:`auvtrack.simulation.api.prepare`.
+    stop : StopSignal, optional
+        Shared stop request; when set, this run stops with status ``"interrupted"``.
 
     Returns
     -------
     RunSummary
         Bit-identical metrics, status and failure to :func:`~auvtrack.simulation.api.run_prepared`.
     """
-    log = np.empty((0, len(prep.channels)))
-    acc = np.empty(METRICS_SIZE)
-    metrics_init(acc)
-    fail_state = np.zeros(prep.X0.size)
-    cause, _, t_stop = engine.run_kernel(int(prep.si[engine.SI_CODE]), prep.X0, prep.si, prep.sf, prep.cp,
-                                         prep.vp_nom, prep.vp_true, prep.ref_p, prep.d_rows, prep.d_cur,
-                                         prep.noise, log, acc, fail_state)
-    return _summary(prep, cause, t_stop, acc, fail_state)
+    ensure_compiled([prep])
+    out = outputs_for(prep, rows=0)
+    if stop is not None:
+        stop.register(out.info)
+    cause, _, t_stop = call_kernel(prep, out)
+    return _summary(prep, cause, t_stop, out)
 
 
-@njit(nogil=True, parallel=True)
-def batch_kernel(codes, X0s, sis, sfs, cps, vp_noms, vp_trues, ref_ps, d_rows, d_curs, noises, ncols, accs,
-                 fail_states, causes, t_stops):
-    """Run ``len(codes)`` closed loops of identical array shapes in a ``prange`` loop, metrics only.
-
-    Row ``i`` of every stacked argument is run ``i``'s array for
-    :func:`~auvtrack.simulation.engine.run_kernel`; ``accs`` (n, METRICS_SIZE) must be
-    initialised by :func:`~auvtrack.simulation.metrics.metrics_init`.  Writes ``causes``,
-    ``t_stops``, ``accs`` and ``fail_states``.
-    """
-    n = codes.shape[0]
-    for i in numba.prange(n):
-        log = np.empty((0, ncols))
-        cause, _, t_stop = engine.run_kernel(codes[i], X0s[i], sis[i], sfs[i], cps[i], vp_noms[i], vp_trues[i],
-                                             ref_ps[i], d_rows[i], d_curs[i], noises[i], log, accs[i], fail_states[i])
-        causes[i] = cause
-        t_stops[i] = t_stop
+def _trajectory(prep: Prepared, stop: StopSignal | None = None) -> Result:
+    ensure_compiled([prep])
+    out = outputs_for(prep)
+    if stop is not None:
+        stop.register(out.info)
+    wall = time.perf_counter()
+    cause, rows, t_stop = call_kernel(prep, out)
+    return result_from(prep, out, cause, rows, t_stop, time.perf_counter() - wall)
 
 
 def _shape_key(p: Prepared) -> tuple:
-    return (p.X0.shape, p.cp.shape, p.ref_p.shape, p.d_rows.shape, p.d_cur.shape, p.noise.shape, len(p.channels))
+    return (p.key, p.plant.x0.shape, p.controller.x0.shape, p.cp.shape, p.plant.pp.shape, p.ref_p.shape,
+            p.environment.rows.shape, p.environment.current.shape, p.environment.noise.shape, len(p.channels))
 
 
-def _run_prange(preps: Sequence[Prepared]) -> list[RunSummary]:
+def _stack(arrays: list[np.ndarray]) -> np.ndarray:
+    return np.ascontiguousarray(np.stack(arrays))
+
+
+def _run_prange(preps: Sequence[Prepared], stop: StopSignal) -> list[RunSummary]:
     groups: dict[tuple, list[int]] = {}
     for i, p in enumerate(preps):
         groups.setdefault(_shape_key(p), []).append(i)
@@ -141,19 +178,25 @@ def _run_prange(preps: Sequence[Prepared]) -> list[RunSummary]:
     for idx in groups.values():
         ps = [preps[i] for i in idx]
         n = len(ps)
-        stack = lambda name: np.ascontiguousarray(np.stack([getattr(p, name) for p in ps]))  # noqa: E731
+        ensure_compiled(ps[:1])
+        runs = kernels.kernel_module(ps[0].key).run_many
         accs = np.empty((n, METRICS_SIZE))
         for k in range(n):
             metrics_init(accs[k])
-        fails = np.zeros((n, ps[0].X0.size))
+        fails = np.zeros((n, 2, ps[0].n_state))
+        infos = np.zeros((n, engine.INFO_SIZE), dtype=np.int64)
+        stop.register(infos)
         causes = np.zeros(n, dtype=np.int64)
         t_stops = np.zeros(n)
-        codes = np.array([int(p.si[engine.SI_CODE]) for p in ps], dtype=np.int64)
-        batch_kernel(codes, stack("X0"), stack("si"), stack("sf"), stack("cp"), stack("vp_nom"), stack("vp_true"),
-                     stack("ref_p"), stack("d_rows"), stack("d_cur"), stack("noise"), len(ps[0].channels), accs,
-                     fails, causes, t_stops)
+        runs(_stack([p.plant.pp for p in ps]), _stack([p.plant.x0 for p in ps]),
+             _stack([p.cp for p in ps]), _stack([p.controller.x0 for p in ps]), _stack([p.vp_nom for p in ps]),
+             _stack([p.environment.rows for p in ps]), _stack([p.environment.current for p in ps]),
+             _stack([p.environment.noise for p in ps]), _stack([p.ref_p for p in ps]),
+             _stack([p.si for p in ps]), _stack([p.sf for p in ps]), len(ps[0].channels),
+             accs, fails, infos, causes, t_stops)
         for k, i in enumerate(idx):
-            out[i] = _summary(preps[i], causes[k], t_stops[k], accs[k], fails[k])
+            o = Outputs(np.empty((0, len(ps[0].channels))), accs[k], fails[k], infos[k])
+            out[i] = _summary(preps[i], int(causes[k]), float(t_stops[k]), o)
     return out  # type: ignore[return-value]
 
 
@@ -164,7 +207,7 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     Parameters
     ----------
     preps : sequence of Prepared
-        From :func:`auvtrack.simulation.api.prepare`; any mix of controllers and shapes.
+        From :func:`auvtrack.simulation.api.prepare`; any mix of controllers, plants and shapes.
     trajectories : bool, optional
         Return full :class:`~auvtrack.simulation.result.Result` objects (as
         :func:`~auvtrack.simulation.api.run_prepared`) instead of metrics-only summaries.
@@ -183,6 +226,9 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     ------
     ValueError
         Unknown ``backend`` or ``workers`` < 1.
+    BatchInterrupted
+        On Ctrl-C: every run in flight stops within about a second; its ``results`` hold every
+        outcome (``"interrupted"`` for runs cut short or not started).
     """
     if backend not in BACKENDS:
         raise ValueError(f"backend: must be one of {', '.join(BACKENDS)} (got {backend!r})")
@@ -192,13 +238,35 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     preps = list(preps)
     if not preps:
         return []
-    fn: Callable[[Prepared], Any] = run_prepared if trajectories else run_metrics
+    ensure_compiled(preps)
+    stop = StopSignal()
+    fn: Callable[[Prepared, StopSignal], Any] = _trajectory if trajectories else run_metrics
     if backend == "prange" and not trajectories:
-        return _run_prange(preps)
+        return _guarded(lambda: _run_prange(preps, stop), stop)
     if backend == "serial" or workers == 1 or len(preps) == 1:
-        return [fn(p) for p in preps]
-    with ThreadPoolExecutor(max_workers=min(workers, len(preps))) as pool:
-        return list(pool.map(fn, preps))
+        workers = 1
+    pool = ThreadPoolExecutor(max_workers=min(workers, len(preps)))
+    futures = [pool.submit(fn, p, stop) for p in preps]
+    try:
+        results = [f.result() for f in futures]
+    except KeyboardInterrupt:
+        stop.set()
+        results = [f.result() for f in futures]
+        pool.shutdown()
+        raise BatchInterrupted(results) from None
+    pool.shutdown()
+    return results
+
+
+def _guarded(fn, stop: StopSignal):
+    """Run ``fn()`` in a worker thread; on Ctrl-C set ``stop``, wait, and raise :class:`BatchInterrupted`."""
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        fut = pool.submit(fn)
+        try:
+            return fut.result()
+        except KeyboardInterrupt:
+            stop.set()
+            raise BatchInterrupted(fut.result()) from None
 
 
 def iter_batch(items: Iterable[Any], prepare_fn: Callable[[Any], Prepared], *, block: int = 64,

@@ -65,9 +65,9 @@ def bench_singles(kinds: tuple[str, ...], *, repeat: int = 7, duration: float = 
     cpu: dict[str, list[float]] = {k: [] for k in kinds}
     for _ in range(repeat):
         for k, prep in preps.items():
-            t0, c0 = time.perf_counter(), time.thread_time()
+            t0, c0 = time.perf_counter(), time.process_time()
             run_prepared(prep)
-            cpu[k].append(time.thread_time() - c0)
+            cpu[k].append(time.process_time() - c0)
             wall[k].append(time.perf_counter() - t0)
     rows = []
     for k, prep in preps.items():
@@ -80,34 +80,35 @@ def bench_singles(kinds: tuple[str, ...], *, repeat: int = 7, duration: float = 
     return rows
 
 
-def warmup() -> dict:
-    """Compile (or load from the on-disk cache) every kernel, the batch kernels included.
+def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, progress: bool = False) -> dict:
+    """Compile (or load from the on-disk cache) the kernel of every controller on every plant.
 
-    Runs each registered controller's closed loop, its metrics-only (batch) form and the
-    ``prange`` batch kernel once on a 10 ms Section 4 run.
+    Kernels that are not cached compile in parallel, one process per core
+    (:func:`auvtrack.simulation.kernels.warmup`); the ``prange`` batch form of a kernel compiles
+    on its first use.
+
+    Parameters
+    ----------
+    controllers, plants : tuple of str, optional
+        Registered names (default: all).
+    progress : bool, optional
+        Show a progress bar while compiling.
 
     Returns
     -------
     dict
-        ``{"warmup_s": {kind: seconds, ..., "batch": seconds}}``.
+        ``{"kernels": [...], "compiled": [...], "seconds": wall time}``.
     """
     from ..control import CONTROLLERS
-    from ..simulation.api import run_prepared
-    from .batch import run_batch
+    from ..plant import PLANTS
+    from ..simulation import kernels
 
-    out = {}
-    preps = []
-    for kind in CONTROLLERS:
-        t0 = time.perf_counter()
-        prep = _prepared(kind, 0.01)
-        run_prepared(prep)
-        run_batch([prep], backend="serial")
-        preps.append(prep)
-        out[kind] = round(time.perf_counter() - t0, 3)
+    keys = [kernels.KernelKey(CONTROLLERS[c].module, PLANTS[p].module, f"{c} on {p}")
+            for c in (controllers or tuple(CONTROLLERS)) for p in (plants or tuple(PLANTS))]
     t0 = time.perf_counter()
-    run_batch(preps, backend="prange")
-    out["batch"] = round(time.perf_counter() - t0, 3)
-    return {"warmup_s": out}
+    done = kernels.warmup(keys, progress=progress)
+    return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
+            "seconds": round(time.perf_counter() - t0, 2)}
 
 
 def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = False) -> dict:

@@ -14,15 +14,15 @@ from typing import Annotated, Any, Literal, Mapping, Union
 from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_validator,
                       model_validator)
 
-from ..control.params import (FTSMCParams, FXTNTSMCParams, OpenLoopParams, available_gain_presets,
-                              get_gain_preset)
+from ..control import CONTROLLERS
+from ..control.params import FXTNTSMCParams, available_gain_presets, get_gain_preset
 from ..plant.presets import available, get_preset, is_reduced
 from ..plant.presets6 import available6, load_preset6
 from ..plant.reduction import U0_MAX, U0_MIN, default_u0
 from ..plant.truth6 import actuator_values
+from ..reference import build_reference
 
 DEFAULT_PLANT_PRESET = "remus100_prestero"
-from ..reference import build_reference
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
 
@@ -48,9 +48,8 @@ Range2 = tuple[Num, Num]
 Fraction = Annotated[Num, Field(ge=-0.9, le=2.0)]
 Open01 = Annotated[Num, Field(gt=0, lt=1)]
 
-# Controllers selectable by ``[controller] kind``: one parameter model per registered controller
-# (auvtrack.control registers the same models).  To add a controller, append its model here.
-CONTROLLER_MODELS: tuple[type[BaseModel], ...] = (FXTNTSMCParams, FTSMCParams, OpenLoopParams)
+# Controllers selectable by ``[controller] kind``: the parameter model of every registered controller.
+CONTROLLER_MODELS: tuple[type[BaseModel], ...] = tuple(spec.params for spec in CONTROLLERS.values())
 ControllerParams = Annotated[Union[CONTROLLER_MODELS], Field(discriminator="kind")]  # type: ignore[valid-type]
 DEFAULT_CONTROLLER = "fxtntsmc"
 _CONTROLLER_BY_KIND = {m.model_fields["kind"].default: m for m in CONTROLLER_MODELS}

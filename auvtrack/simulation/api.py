@@ -1,7 +1,14 @@
-"""``simulate``: the one entry point from a scenario to a :class:`Result`."""
+"""``simulate``: the one entry point from a scenario to a :class:`Result`.
+
+``simulate`` = :func:`auvtrack.load_scenario` (validation) -> :func:`prepare` (the plant's and the
+controller's set-up: everything becomes packed float64 arrays, bundled as the engine takes them)
+-> :func:`run_prepared` (one call of the compiled kernel of the (controller, plant) pair) ->
+:class:`Result`.
+"""
 from __future__ import annotations
 
 import math
+import threading
 import time
 import warnings
 from dataclasses import dataclass
@@ -11,15 +18,17 @@ import numpy as np
 
 from .. import __version__
 from ..control import get as get_controller
-from ..control.dispatch import CONTROLLER_STATUS
+from ..control.contract import CONTROLLER_STATUS
 from ..environment import build_disturbance, pack_disturbances
 from ..environment.sensors import noise_table
-from ..plant.actuators import pack_actuator
+from ..plant import get as get_plant
 from ..plant.kinematics import attitude, virtual_point
-from ..plant.presets import get_preset, pack_vehicle
+from ..plant.params import ELL
+from ..plant.presets import vehicle_arrays  # noqa: F401  (re-exported: studies use it from here)
 from ..reference import build_reference
 from ..scenario import Scenario, load_scenario
-from . import engine
+from . import engine, kernels
+from .engine import ControllerBundle, EnvironmentBundle, Outputs, PlantBundle, Settings
 from .metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from .result import Result
 
@@ -27,6 +36,20 @@ BASE_CHANNELS = ("t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r",
                  "tau_u", "tau_q", "tau_r", "xd", "yd", "zd", "ex", "ey", "ez")
 CHI_CHANNELS = ("chi_x", "chi_y", "chi_z")
 STATE_NAMES = BASE_CHANNELS[1:11]
+
+
+class SimulationInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or a stop request) ended a simulation; ``result`` holds what was computed.
+
+    Attributes
+    ----------
+    result : Result
+        The partial result, status ``"interrupted"``.
+    """
+
+    def __init__(self, result: "Result") -> None:
+        super().__init__("simulation interrupted")
+        self.result = result
 
 
 @dataclass(frozen=True)
@@ -43,51 +66,79 @@ class SetupContext:
         Initial virtual-point error eta1(0) - eta_d(0) (m).
     seed : int
         Scenario seed.
+    actuator : object
+        The scenario's ``[actuator]`` section (``tau_max``, ``rate_max``), e.g. for anti-windup.
+    dt : float
+        RK4 step (s).
+    control_rate : float
+        Controller sampling rate (Hz; 0 = continuous).
     """
 
     vp_nom: np.ndarray
     refm0: np.ndarray
     e0: np.ndarray
     seed: int
+    actuator: Any = None
+    dt: float = 0.001
+    control_rate: float = 0.0
 
 
 @dataclass(frozen=True)
 class Prepared:
-    """A scenario turned into the arrays of :func:`auvtrack.simulation.engine.run_kernel`."""
+    """A scenario turned into the bundles of the engine's kernel (:mod:`auvtrack.simulation.engine`).
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The validated scenario.
+    key : KernelKey
+        The (controller law, plant) pair whose kernel runs it.
+    plant, controller, environment, settings
+        The engine's bundles.
+    ref_p : numpy.ndarray
+        Packed reference.
+    n_rows : int
+        Logged rows.
+    channels : tuple of str
+        Logged channel names, in column order.
+    notes : tuple of str
+        Set-up messages for the user.
+    resolved : dict
+        Derived values recorded in ``run.json``.
+    statuses : dict of int to str
+        Messages of the controller's status codes.
+    """
 
     scenario: Scenario
-    X0: np.ndarray
-    si: np.ndarray
-    sf: np.ndarray
-    cp: np.ndarray
-    vp_nom: np.ndarray
-    vp_true: np.ndarray
+    key: kernels.KernelKey
+    plant: PlantBundle
+    controller: ControllerBundle
+    environment: EnvironmentBundle
     ref_p: np.ndarray
-    d_rows: np.ndarray
-    d_cur: np.ndarray
-    noise: np.ndarray
+    settings: Settings
     n_rows: int
     channels: tuple[str, ...]
     notes: tuple[str, ...]
     resolved: dict
+    statuses: dict
 
+    # short names for the most used arrays
+    si = property(lambda self: self.settings.si, doc="Integer settings (engine SI_*).")
+    sf = property(lambda self: self.settings.sf, doc="Float settings (engine SF_*).")
+    cp = property(lambda self: self.controller.cp, doc="Packed controller parameters.")
+    vp_nom = property(lambda self: self.controller.vp, doc="Packed nominal 5-DOF vehicle.")
+    pp = property(lambda self: self.plant.pp, doc="Packed true-plant parameters.")
+    noise = property(lambda self: self.environment.noise, doc="Sensor noise table.")
 
-def vehicle_arrays(sc: Scenario) -> tuple[np.ndarray, np.ndarray, dict]:
-    """Nominal and true packed vehicles (uncertainty applied to the true plant) and their record."""
-    pre = get_preset(sc.vehicle.preset)
-    v = sc.vehicle
-    m = np.array(v.m if v.m is not None else pre.m, dtype=float)
-    d = np.array(v.d if v.d is not None else pre.d, dtype=float)
-    wgml = float(v.wgml if v.wgml is not None else pre.wgml)
-    ell = float(v.l if v.l is not None else pre.l)
-    u = sc.uncertainty
-    vp_nom = pack_vehicle(m, d, wgml, ell, 1.0)
-    vp_true = pack_vehicle(m * (1 + u.M), d * (1 + u.D), wgml * (1 + u.G), ell, 1.0 + u.C)
-    record = {"preset": pre.name, "m": m.tolist(), "d": d.tolist(), "wgml": wgml, "l": ell,
-              "sources": pre.sources,
-              "true_plant": {"m": (m * (1 + u.M)).tolist(), "d": (d * (1 + u.D)).tolist(),
-                             "wgml": wgml * (1 + u.G), "c_scale": 1.0 + u.C}}
-    return vp_nom, vp_true, record
+    @property
+    def n_steps(self) -> int:
+        """RK4 steps planned."""
+        return int(self.settings.si[engine.SI_NSTEPS])
+
+    @property
+    def n_state(self) -> int:
+        """Plant plus controller states."""
+        return self.plant.x0.size + self.controller.x0.size
 
 
 def _steps(value: float, dt: float, name: str) -> int:
@@ -95,6 +146,10 @@ def _steps(value: float, dt: float, name: str) -> int:
     if n < 1 or abs(n * dt - value) > 1e-9 * max(1.0, value):
         raise ValueError(f"{name} ({value}) must be a positive integer multiple of sim.dt ({dt})")
     return n
+
+
+def _c(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 def prepare(scenario: Scenario) -> Prepared:
@@ -108,45 +163,125 @@ def prepare(scenario: Scenario) -> Prepared:
     Returns
     -------
     Prepared
-        Packed float64 arrays, the logged channel names and the start-treatment notes.
+        Packed float64 arrays in the engine's bundles, the logged channel names and the set-up
+        notes.
 
     Raises
     ------
     ValueError
-        If the controller refuses the set-up (e.g. a start on the envelope with the
+        If the plant or the controller refuses the set-up (e.g. a start on the envelope with the
         treatment off), naming the field.
     """
     sc = scenario
-    vp_nom, vp_true, vehicle_record = vehicle_arrays(sc)
+    plant_spec = get_plant(sc.plant.model) if hasattr(sc, "plant") else get_plant("5dof")
+    cpl = plant_spec.setup(sc)
+    vp_nom, _, _ = vehicle_arrays(sc)
     ref = build_reference(dict(sc.reference))
     ref_p = ref.pack()
     tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     eta0 = np.array(sc.initial.eta, dtype=float)
-    nu0 = np.array(sc.initial.nu, dtype=float)
     p0, v0, a0 = ref.evaluate(0.0)
     refm0 = np.vstack([p0, v0, a0])
-    p1 = np.array(virtual_point(tuple(eta0), attitude(eta0[3], eta0[4]), vp_nom[engine.ELL]))
-    ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed)
-    cc = get_controller(sc.controller.kind).setup(sc, ctx)
+    p1 = np.array(virtual_point(tuple(eta0), attitude(eta0[3], eta0[4]), vp_nom[ELL]))
+    ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed, actuator=sc.actuator,
+                       dt=sc.sim.dt, control_rate=sc.sim.control_rate)
+    cspec = get_controller(sc.controller.kind)
+    cc = cspec.setup(sc, ctx)
     dt = sc.sim.dt
     n_steps = _steps(sc.sim.duration, dt, "sim.duration")
     log_every = _steps(sc.sim.log_dt, dt, "sim.log_dt")
     ctrl_every = 0 if sc.sim.control_rate == 0 else _steps(1.0 / sc.sim.control_rate, dt, "1/sim.control_rate")
     naux = len(cc.aux_names)
-    si = np.array([n_steps, log_every, ctrl_every, cc.code, naux, cc.xc0.size], dtype=np.int64)
+    si = np.array([n_steps, log_every, ctrl_every, naux], dtype=np.int64)
     t0, t1 = sc.metrics.window
-    sf = np.concatenate([[dt, math.radians(sc.sim.theta_limit), sc.sim.state_limit, t0,
-                          t1 if math.isfinite(t1) else 1e300],
-                         pack_actuator(sc.actuator.tau_max, sc.actuator.rate_max)])
+    phi_limit = getattr(sc.sim, "phi_limit", 90.0)
+    sf = np.array([dt, math.radians(sc.sim.theta_limit), sc.sim.state_limit, t0,
+                   t1 if math.isfinite(t1) else 1e300, math.radians(phi_limit)])
+    assert si.size == engine.SI_SIZE and sf.size == engine.SF_SIZE
     sigma = (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu)
     if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
     noise = noise_table(sc.seed, n_steps // ctrl_every + 1 if ctrl_every else 1, sigma)
-    X0 = np.concatenate([eta0, nu0, cc.xc0]).astype(np.float64)
-    return Prepared(sc, X0, si, sf, np.ascontiguousarray(cc.cp, dtype=np.float64), vp_nom, vp_true,
-                    ref_p, tables.rows, tables.current, noise, n_steps // log_every + 1,
-                    BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS, tuple(cc.notes),
-                    {"vehicle": vehicle_record, "controller": cc.resolved})
+    key = kernels.KernelKey(cc.law or cspec.module, plant_spec.module, f"{cspec.name} on {plant_spec.name}")
+    return Prepared(
+        scenario=sc, key=key,
+        plant=PlantBundle(_c(cpl.pp), _c(cpl.x0)),
+        controller=ControllerBundle(_c(cc.cp), _c(cc.xc0), _c(vp_nom)),
+        environment=EnvironmentBundle(_c(tables.rows), _c(tables.current), _c(noise)),
+        ref_p=_c(ref_p), settings=Settings(si, sf),
+        n_rows=n_steps // log_every + 1,
+        channels=BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names),
+        notes=tuple(cpl.notes) + tuple(cc.notes),
+        resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
+                  "controller": cc.resolved},
+        statuses={**CONTROLLER_STATUS, **cspec.statuses},
+    )
+
+
+def outputs_for(prep: Prepared, rows: int | None = None) -> Outputs:
+    """Fresh output arrays for one run of ``prep`` (``rows`` logged rows; default all, 0 = metrics only).
+
+    Parameters
+    ----------
+    prep : Prepared
+        The run.
+    rows : int, optional
+        Rows of the log.
+
+    Returns
+    -------
+    Outputs
+        Log (NaN), initialised metrics accumulator, failure state and info arrays.
+    """
+    n = prep.n_rows if rows is None else rows
+    acc = np.zeros(METRICS_SIZE)
+    metrics_init(acc)
+    return Outputs(np.full((n, len(prep.channels)), np.nan), acc, np.zeros((2, prep.n_state)),
+                   np.zeros(engine.INFO_SIZE, dtype=np.int64))
+
+
+def ensure_compiled(preps: Sequence[Prepared], *, progress: bool = False) -> None:
+    """Compile (or load) the kernels that ``preps`` need, with the "compiling kernels" notice if any is new.
+
+    Parameters
+    ----------
+    preps : sequence of Prepared
+        Runs about to start.
+    progress : bool, optional
+        Show a progress bar over the kernels being compiled.
+    """
+    kernels.warmup([p.key for p in preps], progress=progress)
+
+
+def call_kernel(prep: Prepared, out: Outputs) -> tuple[int, int, float]:
+    """Run the kernel of ``prep`` into ``out``; return (cause, rows logged, stop time)."""
+    run = kernels.kernel(prep.key)
+    cause, rows, t_stop = run(prep.plant, prep.controller, prep.environment, prep.ref_p, prep.settings, out)
+    return int(cause), int(rows), float(t_stop)
+
+
+def _in_worker_thread(fn, stop: np.ndarray):
+    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag."""
+    box: dict[str, Any] = {}
+
+    def target():
+        try:
+            box["value"] = fn()
+        except BaseException as exc:  # pragma: no cover - re-raised below
+            box["error"] = exc
+
+    th = threading.Thread(target=target, name="auvtrack-run", daemon=True)
+    th.start()
+    interrupted = False
+    while th.is_alive():
+        try:
+            th.join(0.05)
+        except KeyboardInterrupt:
+            stop[engine.INFO_STOP] = 1
+            interrupted = True
+    if "error" in box:
+        raise box["error"]
+    return box["value"], interrupted
 
 
 def run_prepared(prep: Prepared) -> Result:
@@ -161,39 +296,86 @@ def run_prepared(prep: Prepared) -> Result:
     -------
     Result
         The logged trajectory, metrics, status and (for a failed run) the failure record.
+
+    Raises
+    ------
+    SimulationInterrupted
+        On Ctrl-C during the run (within about a second); its ``result`` is the partial run.
     """
-    log = np.full((prep.n_rows, len(prep.channels)), np.nan)
-    acc = np.zeros(METRICS_SIZE)
-    metrics_init(acc)
-    fail_state = np.zeros(prep.X0.size)
+    ensure_compiled([prep])
+    out = outputs_for(prep)
     wall = time.perf_counter()
-    cause, rows, t_stop = engine.run_kernel(int(prep.si[engine.SI_CODE]), prep.X0, prep.si, prep.sf, prep.cp, prep.vp_nom, prep.vp_true,
-                                            prep.ref_p, prep.d_rows, prep.d_cur, prep.noise, log, acc, fail_state)
+    if threading.current_thread() is threading.main_thread():
+        (cause, rows, t_stop), interrupted = _in_worker_thread(lambda: call_kernel(prep, out), out.info)
+    else:
+        (cause, rows, t_stop), interrupted = call_kernel(prep, out), False
     wall = time.perf_counter() - wall
-    failure = None if cause == engine.CAUSE_NONE else _failure(cause, t_stop, fail_state, prep)
+    result = result_from(prep, out, cause, rows, t_stop, wall)
+    if interrupted or cause == engine.CAUSE_INTERRUPTED:
+        raise SimulationInterrupted(result)
+    return result
+
+
+def result_from(prep: Prepared, out: Outputs, cause: int, rows: int, t_stop: float, wall: float) -> Result:
+    """Wrap a finished kernel call in a :class:`Result` (trajectory, metrics, status, failure, meta)."""
+    failure = None if cause == engine.CAUSE_NONE else failure_record(cause, t_stop, out.fail_state, prep)
     sc = prep.scenario
     t0, t1 = sc.metrics.window
-    metrics = metrics_finalize(acc, t0, min(t1, t_stop))
-    channels = {name: log[:rows, j].copy() for j, name in enumerate(prep.channels)}
+    metrics = metrics_finalize(out.acc, t0, min(t1, t_stop))
+    channels = {name: out.log[:rows, j].copy() for j, name in enumerate(prep.channels)}
     resolved = sc.to_dict()
     resolved["resolved"] = prep.resolved
     meta = {"version": __version__, "wall_time_s": wall, "notes": list(prep.notes),
-            "steps": int(prep.si[engine.SI_NSTEPS])}
-    return Result(channels, resolved, "ok" if failure is None else "failed", failure, metrics, meta)
+            "steps": int(out.info[engine.INFO_STEPS]), "steps_planned": prep.n_steps}
+    return Result(channels, resolved, status_of(cause), failure, metrics, meta)
 
 
-def _failure(cause: int, t: float, state: np.ndarray, prep: Prepared) -> dict[str, Any]:
+def status_of(cause: int) -> str:
+    """``"ok"``, ``"interrupted"`` or ``"failed"`` for a kernel's stop cause."""
+    if cause == engine.CAUSE_NONE:
+        return "ok"
+    return "interrupted" if cause == engine.CAUSE_INTERRUPTED else "failed"
+
+
+def failure_record(cause: int, t: float, fail_state: np.ndarray, prep: Prepared) -> dict[str, Any]:
+    """The ``Result.failure`` record of a stop: time, cause, detail, state and last finite state.
+
+    Parameters
+    ----------
+    cause : int
+        Kernel stop cause (``engine.CAUSE_*`` or ``CAUSE_CONTROLLER`` + status).
+    t : float
+        Stop time (s).
+    fail_state : numpy.ndarray
+        (2, n): the state at the stop and the last finite state.
+    prep : Prepared
+        The run (for channel names and status messages).
+
+    Returns
+    -------
+    dict
+        ``time``, ``cause``, ``detail``, ``state`` and, when they differ, ``last_finite_state``.
+    """
     if cause >= engine.CAUSE_CONTROLLER:
         name = "controller"
-        detail = CONTROLLER_STATUS.get(cause - engine.CAUSE_CONTROLLER, f"status {cause - engine.CAUSE_CONTROLLER}")
+        status = cause - engine.CAUSE_CONTROLLER
+        detail = prep.statuses.get(status, f"status {status}")
     else:
-        name = {engine.CAUSE_NONFINITE: "nonfinite", engine.CAUSE_PITCH: "pitch_limit",
-                engine.CAUSE_STATE_LIMIT: "state_limit"}[cause]
-        detail = engine.CAUSES[cause]
-    st = {n: float(state[i]) for i, n in enumerate(STATE_NAMES)}
-    if state.size > 10:
-        st["controller_state"] = [float(x) for x in state[10:]]
-    return {"time": float(t), "cause": name, "detail": detail, "state": st}
+        name, detail = engine.CAUSES[cause]
+    record = {"time": float(t), "cause": name, "detail": detail, "state": _state_dict(fail_state[0], prep)}
+    if not np.array_equal(fail_state[0], fail_state[1], equal_nan=True):
+        record["last_finite_state"] = _state_dict(fail_state[1], prep)
+    return record
+
+
+def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
+    nxp = prep.plant.x0.size
+    st: dict[str, Any] = {n: float(state[i]) for i, n in enumerate(STATE_NAMES)}
+    if nxp > len(STATE_NAMES):
+        st["plant_state"] = [float(x) for x in state[:nxp]]
+    if state.size > nxp:
+        st["controller_state"] = [float(x) for x in state[nxp:]]
+    return st
 
 
 def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | Mapping = (), *,
@@ -214,6 +396,11 @@ def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | Mapp
     Result
         Logged channels, metrics, status and failure diagnostic; a failed run keeps its
         partial trajectory.
+
+    Raises
+    ------
+    SimulationInterrupted
+        On Ctrl-C; its ``result`` holds the partial run.
 
     Examples
     --------

@@ -1,21 +1,30 @@
-"""Compiled closed loop: plant, environment, reference and controller under fixed-step RK4.
+"""Compiled closed loop: a plant, the environment, a reference and a controller under fixed-step RK4.
 
-State X = [eta (5), nu (5), xc (nc)]: the plant and the controller's internal states (adaptive
-weights, envelope filters) are integrated together.  Two modes:
+The plant state ``xp`` (the plant module's ``NX`` states) and the controller's internal state
+``xc`` (adaptive weights, envelope filters, integrators) are integrated together.  Two modes:
 
-* continuous (``ctrl_every = 0``): the controller is evaluated at every RK4 stage;
-* sampled-data (``ctrl_every = k``): the controller runs every k steps on the measured state and
-  its input tau and internal-state derivative are held (zero-order hold) until the next sample.
+* continuous (``ctrl_every = 0``): the controller and the plant's allocation are evaluated at
+  every RK4 stage;
+* sampled-data (``ctrl_every = k``): they run every k steps on the measured state, and the
+  actuator command and the controller's state derivative are held (zero-order hold) until the
+  next sample.  The controller sees the plant's 5-DOF pose plus row k of the seeded noise table.
 
-Actuators and sensors (:mod:`auvtrack.plant.actuators`, :mod:`auvtrack.environment.sensors`):
-the applied input is the command saturated to ``|tau_j| <= tau_max_j`` (both modes); in
-sampled-data mode it is also rate limited between samples (from tau = 0 at t = 0), and the
-controller sees the state plus row k of the seeded noise table ``noise`` at sample k.  Logs and
-metrics always use the true state and the applied input.
+Logs and metrics always use the true state and the input the plant actually produces.  One row
+is logged every ``log_every`` steps into a preallocated array (O(N) in total).  After every step
+the state is checked; a failure stops the run at once and keeps what was logged.  Every 1024
+steps the loop reads ``info[INFO_STOP]``: a non-zero value (set from another thread, e.g. on
+Ctrl-C) stops the run with cause :data:`CAUSE_INTERRUPTED`.
 
-One row is logged every ``log_every`` steps into a preallocated array (O(N) in total).  After
-every step the state is checked; a failure stops the run at once and keeps what was logged.
-Integer settings ``si`` and float settings ``sf`` use the index constants below.
+**How the kernels are made.**  The functions marked ``@kernel_part`` below call the controller's
+compiled law as ``law(...)`` and the plant's compiled functions as ``plant.f(...)`` (the
+contracts: :mod:`auvtrack.control.contract`, ``docs/architecture.md``).  They are not compiled
+here: :mod:`auvtrack.simulation.kernels` writes, for each (controller, plant) pair a run needs, a
+module that binds ``law`` and ``plant`` and holds a verbatim copy of these functions, and
+compiles it once (cached on disk).  This file is the one source of the loop.
+
+Arguments come in bundles (:class:`PlantBundle`, :class:`ControllerBundle`,
+:class:`EnvironmentBundle`, :class:`Settings`, :class:`Outputs`); integer settings ``si`` and
+float settings ``sf`` use the index constants below.
 
 Performance note: arrays are passed whole and indexed, never sliced, in the hot path (a slice
 is a reference-counted view whose atomic inc/decrements cost more than the arithmetic).
@@ -23,79 +32,127 @@ is a reference-counted view whose atomic inc/decrements cost more than the arith
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import literally
+from numba import prange
 
 from .._jit import njit, njit_noalloc
-from ..control import ftsmc, fxtntsmc, open_loop
-from ..control.dispatch import NX_PLANT, WORK_SIZE, control
+from ..control.contract import WORK_SIZE
 from ..control.tracking import lumped_disturbance
-from ..environment import eval_disturbance
 from ..environment.layout import KIND_PAPER, KIND_PULSE
 from ..environment.sensors import measure
-from ..plant.actuators import ACT_SIZE, rate_limit, saturate
+from ..plant.contract import CAUSE_PITCH, CAUSE_ROLL, SCRATCH_SIZE, SF_PHI_LIM, SF_THETA_LIM
 from ..plant.dynamics import nu_dot
-from ..plant.kinematics import attitude, eta_dot, virtual_point
+from ..plant.kinematics import attitude, virtual_point
 from ..plant.params import ELL
 from ..reference import eval_reference
-from .metrics import metrics_update
+from .metrics import metrics_update, saturation_update
 
-SI_NSTEPS, SI_LOG_EVERY, SI_CTRL_EVERY, SI_CODE, SI_NAUX, SI_NC = range(6)
-SI_SIZE = 6
-SF_DT, SF_THETA_LIM, SF_STATE_LIM, SF_WIN_T0, SF_WIN_T1, SF_ACT = range(6)
-SF_SIZE = SF_ACT + ACT_SIZE  # sf[SF_ACT:] = actuator limits [tau_max (3), rate_max (3)]
+SI_NSTEPS, SI_LOG_EVERY, SI_CTRL_EVERY, SI_NAUX = range(4)
+SI_SIZE = 4
+SF_DT, SF_STATE_LIM, SF_WIN_T0, SF_WIN_T1 = 0, 2, 3, 4
+SF_SIZE = 6  # [dt, theta_lim, state_lim, t0, t1, phi_lim]; theta_lim, phi_lim: plant.contract
+assert SF_THETA_LIM == 1 and SF_PHI_LIM == 5
+INFO_STOP, INFO_STEPS = 0, 1
+INFO_SIZE = 2
+STOP_POLL = 1024  # steps between two reads of the stop flag (a power of two)
 
-# logged row: t, eta(5), nu(5), tau(3), eta_d(3), e(3), aux(naux), chi(3)
+# logged row: t, eta(5), nu(5), tau(3), eta_d(3), e(3), aux(naux), chi(3), plant channels(N_LOG)
 N_BASE_COLS = 20
 
-CAUSE_NONE, CAUSE_NONFINITE, CAUSE_PITCH, CAUSE_STATE_LIMIT = 0, 1, 2, 3
+CAUSE_NONE, CAUSE_NONFINITE, CAUSE_STATE_LIMIT, CAUSE_INTERRUPTED = 0, 1, 3, 4
 CAUSE_CONTROLLER = 10  # + controller status code
 CAUSES = {
-    CAUSE_NONFINITE: "non-finite state (NaN or Inf)",
-    CAUSE_PITCH: "pitch limit exceeded (|theta| beyond sim.theta_limit)",
-    CAUSE_STATE_LIMIT: "state limit exceeded (divergence, |state| > sim.state_limit)",
+    CAUSE_NONFINITE: ("nonfinite", "non-finite state (NaN or Inf)"),
+    CAUSE_PITCH: ("pitch_limit", "pitch limit exceeded (|theta| beyond sim.theta_limit)"),
+    CAUSE_STATE_LIMIT: ("state_limit", "state limit exceeded (divergence, |state| > sim.state_limit)"),
+    CAUSE_INTERRUPTED: ("interrupted", "interrupted by the user (Ctrl-C) or a stop request"),
+    CAUSE_ROLL: ("roll_limit", "roll limit exceeded (|phi| beyond sim.phi_limit)"),
 }
+"""Stop causes other than a controller status: code -> (name, detail)."""
 STATUS_NONFINITE_INPUT = 3
-assert (ftsmc.CODE, fxtntsmc.CODE, open_loop.CODE) == (1, 2, 3), "update run_kernel's branches"
 
 
-@njit_noalloc
-def plant_state(X):
-    """(eta, nu) tuples of the plant part of X."""
-    return (X[0], X[1], X[2], X[3], X[4]), (X[5], X[6], X[7], X[8], X[9])
+class PlantBundle(NamedTuple):
+    """The true plant: packed parameters ``pp`` and initial state ``x0`` (plant module layout)."""
+
+    pp: np.ndarray
+    x0: np.ndarray
 
 
-@njit_noalloc
-def closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold, dX, tau, aux,
-                    refm, omega, work, att, fresh, sf):
-    """Write dX/dt; return 0 or a controller status.  ``hold`` = [tau (3), dxc] in sampled mode.
+class ControllerBundle(NamedTuple):
+    """The controller: packed gains ``cp``, initial internal state ``x0``, nominal vehicle ``vp``."""
 
-    ``att`` is :func:`attitude` of X (the caller computes it once per stage).  With ``fresh``
-    false the reference ``refm`` and disturbance ``omega`` of the previous call are reused: the
-    engine passes false only for the second of two stages at the same time whose disturbance
-    does not depend on the state (RK4 stages 2 and 3), so the values are the same numbers.
+    cp: np.ndarray
+    x0: np.ndarray
+    vp: np.ndarray
+
+
+class EnvironmentBundle(NamedTuple):
+    """Disturbance tables ``rows`` and ``current`` (:mod:`auvtrack.environment`), sensor ``noise``."""
+
+    rows: np.ndarray
+    current: np.ndarray
+    noise: np.ndarray
+
+
+class Settings(NamedTuple):
+    """Integer settings ``si`` (SI_*) and float settings ``sf`` (SF_*)."""
+
+    si: np.ndarray
+    sf: np.ndarray
+
+
+class Outputs(NamedTuple):
+    """Written by the kernel.
+
+    ``log`` (n_rows, n_channels); ``acc`` the metrics accumulator; ``fail_state`` (2, nxp + nxc):
+    row 0 the state at the stop, row 1 the last finite state (the state at the start of the
+    failing step); ``info`` int64 (INFO_*): the stop request (read) and the steps run (written).
     """
-    literally(code)
-    eta, nu = plant_state(X)
-    if fresh:
-        eval_reference(ref_p, t, refm)
-    if ctrl_every == 0:
-        status = control(code, t, eta, nu, att, X, refm, vp_nom, cp, tau, dX, aux, work)
-        if status != 0:
-            return status
-        tau[0], tau[1], tau[2] = saturate((tau[0], tau[1], tau[2]), sf, SF_ACT)
-    else:
-        tau[0], tau[1], tau[2] = hold[0], hold[1], hold[2]
-        for i in range(NX_PLANT, nx):
-            dX[i] = hold[3 + i - NX_PLANT]
-    if fresh:
-        eval_disturbance(d_rows, d_cur, t, eta, nu, vp_true, omega)
-    dX[0], dX[1], dX[2], dX[3], dX[4] = eta_dot(att, nu)
-    dX[5], dX[6], dX[7], dX[8], dX[9] = nu_dot(att, nu, (tau[0], tau[1], tau[2]),
-                                               (omega[0], omega[1], omega[2], omega[3], omega[4]), vp_true)
-    return 0
 
+    log: np.ndarray
+    acc: np.ndarray
+    fail_state: np.ndarray
+    info: np.ndarray
+
+
+KERNEL_PARTS: dict[str, str] = {}
+"""Name of each kernel part -> the decorator it is compiled with in a generated kernel module."""
+
+
+def kernel_part(decorator: str):
+    """Mark a function as part of the loop that :mod:`auvtrack.simulation.kernels` copies per (law, plant).
+
+    Parameters
+    ----------
+    decorator : str
+        Python source of the decorator the copy gets, e.g. ``"njit(nogil=True)"``.
+
+    Returns
+    -------
+    callable
+        A decorator that records the function and returns it unchanged (not compiled here).
+    """
+    def mark(fn):
+        KERNEL_PARTS[fn.__name__] = decorator
+        return fn
+    return mark
+
+
+def example_arguments() -> tuple:
+    """Arguments of ``run`` with the exact types every prepared run passes (to compile ahead of time).
+
+    Every array is C-contiguous and writeable: float64 except the int64 ``si`` and ``info``.
+    """
+    f1, f2 = np.zeros(1), np.zeros((1, 1))
+    return (PlantBundle(f1, f1), ControllerBundle(f1, f1, f1), EnvironmentBundle(f2, f2, f2), f1,
+            Settings(np.zeros(SI_SIZE, np.int64), np.zeros(SF_SIZE)),
+            Outputs(f2, f1, f2, np.zeros(INFO_SIZE, np.int64)))
+
+
+# ------------------------------------------------------------------ helpers (compiled here)
 
 @njit
 def state_free_disturbance(d_rows):
@@ -106,149 +163,222 @@ def state_free_disturbance(d_rows):
     return True
 
 
+@njit_noalloc
+def finite3(v):
+    """True when the three entries of ``v`` are finite."""
+    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
+
+
+@njit_noalloc(inline="always")
+def scan_state(x, state_lim):
+    """(any non-finite, any |x_i| > state_lim) over one state array, one pass."""
+    nonfinite = over = False
+    for i in range(x.shape[0]):
+        v = x[i]
+        if not math.isfinite(v):
+            nonfinite = True
+        elif abs(v) > state_lim:
+            over = True
+    return nonfinite, over
+
+
 @njit
-def _log_row(log, row, t, X, tau, refm, e, aux, naux, dX, vp_nom):
-    """Fill one logged row (see N_BASE_COLS); chi uses the nominal model with the same input."""
+def record_stop(xp, xc, xp_last, xc_last, fail_state):
+    """Rows of ``fail_state``: the state [xp, xc] at the stop and the last finite state [xp_last, xc_last]."""
+    n = xp.shape[0]
+    for i in range(n):
+        fail_state[0, i], fail_state[1, i] = xp[i], xp_last[i]
+    for i in range(xc.shape[0]):
+        fail_state[0, n + i], fail_state[1, n + i] = xc[i], xc_last[i]
+
+
+# ------------------------------------------------------------------ kernel parts (compiled per law, plant)
+
+@kernel_part("njit_noalloc(inline='always')")
+def state_cause(xp, xc, sf):
+    """Failure cause after a step (precedence: non-finite, the plant's attitude limits, state limit)."""
+    nf_p, over_p = scan_state(xp, sf[SF_STATE_LIM])
+    nf_c, over_c = scan_state(xc, sf[SF_STATE_LIM])
+    nonfinite, over = nf_p or nf_c, over_p or over_c
+    if nonfinite:
+        return CAUSE_NONFINITE
+    cause = plant.attitude_cause(xp, sf)  # noqa: F821  (bound per kernel)
+    if cause != CAUSE_NONE:
+        return cause
+    if over:
+        return CAUSE_STATE_LIMIT
+    return CAUSE_NONE
+
+
+@kernel_part("njit_noalloc")
+def stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd, dxp, dxc, tau, aux,
+          fresh):
+    """One right-hand-side evaluation: write dxp (and dxc); return (controller status, saturation flags).
+
+    ``att`` is the attitude of ``xp`` (computed once per stage by the caller).  In continuous
+    mode the law and the plant's allocation run here (``cmd`` is the previous command when the
+    allocation starts and the new one after it); in sampled-data mode ``cmd`` holds the sample's
+    command and the caller has filled dxc with the held controller derivative.  With ``fresh``
+    false the reference and the plant's cached disturbance of the previous call are reused: the
+    loop passes false only for the second of two stages at the same time whose disturbance does
+    not depend on the state (RK4 stages 2 and 3), so the values are the same numbers.
+    """
+    if fresh:
+        eval_reference(ref_p, t, refm)
+    flags = 0
+    if ctrl_every == 0:
+        eta, nu = plant.pose(xp)  # noqa: F821
+        status = law(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work)  # noqa: F821
+        if status != 0:
+            return status, flags
+        flags = plant.allocate((tau[0], tau[1], tau[2]), eta, nu, xp, pp, cmd, 0.0, cmd)  # noqa: F821
+    plant.rhs(t, xp, att, cmd, (rows, current), pp, scr, fresh, dxp)  # noqa: F821
+    return 0, flags
+
+
+@kernel_part("njit")
+def log_row(log, row, t, xp, cmd, pp, tau, refm, e, aux, naux, dxp, vp):
+    """Fill one logged row (see N_BASE_COLS); chi uses the nominal model with the produced input."""
+    eta, nu = plant.pose(xp)  # noqa: F821
     log[row, 0] = t
-    for i in range(10):
-        log[row, 1 + i] = X[i]
+    for i in range(5):
+        log[row, 1 + i] = eta[i]
+        log[row, 6 + i] = nu[i]
     for i in range(3):
         log[row, 11 + i] = tau[i]
         log[row, 14 + i] = refm[0, i]
         log[row, 17 + i] = e[i]
     for i in range(naux):
         log[row, 20 + i] = aux[i]
-    eta, nu = plant_state(X)
     att = attitude(eta[3], eta[4])
-    dnu_nom = nu_dot(att, nu, (tau[0], tau[1], tau[2]), (0.0, 0.0, 0.0, 0.0, 0.0), vp_nom)
-    chi = lumped_disturbance(att, (dX[5], dX[6], dX[7], dX[8], dX[9]), dnu_nom, vp_nom[ELL])
+    dnu_nom = nu_dot(att, nu, tau, (0.0, 0.0, 0.0, 0.0, 0.0), vp)
+    chi = lumped_disturbance(att, plant.accel5(dxp), dnu_nom, vp[ELL])  # noqa: F821
     log[row, 20 + naux], log[row, 21 + naux], log[row, 22 + naux] = chi
+    plant.log_extra(xp, cmd, pp, log, row, 23 + naux)  # noqa: F821
 
 
-@njit_noalloc(inline="always")
-def _state_cause(X, theta_lim, state_lim):
-    """Failure cause of a state (precedence: non-finite, pitch, state limit), one pass."""
-    nonfinite = over = False
-    for i in range(X.shape[0]):
-        x = X[i]
-        if not math.isfinite(x):
-            nonfinite = True
-        elif abs(x) > state_lim:
-            over = True
-    if nonfinite:
-        return CAUSE_NONFINITE
-    if abs(X[3]) > theta_lim:
-        return CAUSE_PITCH
-    if over:
-        return CAUSE_STATE_LIMIT
-    return CAUSE_NONE
+@kernel_part("njit(nogil=True)")
+def run(pb, cb, env, ref_p, settings, out):
+    """Integrate the closed loop; return (cause, rows_logged, t_stop).
 
-
-@njit_noalloc
-def _finite3(v):
-    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
-
-
-@njit
-def _fail(status, X, fail_state):
-    for i in range(X.shape[0]):
-        fail_state[i] = X[i]
-    return status
-
-
-@njit(nogil=True)
-def run_kernel(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state):
-    """Integrate the closed loop of controller ``code``; return (cause, rows_logged, t_stop).
-
-    The one run-time switch on ``code``: each branch calls :func:`integrate` with a constant,
-    so every controller gets its own specialised, cached loop (registering a controller adds
-    one branch here and one in :mod:`auvtrack.control.dispatch`).  ``log`` has shape
-    (n_rows, N_BASE_COLS + naux + 3); ``acc`` is the metrics accumulator; on failure the
-    state at the stop is copied into ``fail_state``.
+    ``out.log`` has shape (n_rows, N_BASE_COLS + naux + 3 + plant.N_LOG); ``out.acc`` is the
+    metrics accumulator (initialised by :func:`~auvtrack.simulation.metrics.metrics_init`).
     """
-    if code == 1:  # ftsmc.CODE (a literal: numba needs it in the source)
-        return integrate(1, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state)
-    if code == 2:  # fxtntsmc.CODE (a literal: numba needs it in the source)
-        return integrate(2, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state)
-    if code == 3:  # open_loop.CODE (a literal: numba needs it in the source)
-        return integrate(3, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state)
-    return CAUSE_CONTROLLER + 99, 0, 0.0
-
-
-@njit(nogil=True)
-def integrate(code, X0, si, sf, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, noise, log, acc, fail_state):
-    """The RK4 loop of :func:`run_kernel` for one controller; ``code`` is a compile-time literal.
-
-    ``numba.literally`` makes the controller dispatch fold away (a run-time switch per stage
-    costs ~0.3 us); calling this from Python directly would re-type it on every call (~0.1 s),
-    which is why :func:`run_kernel` is the entry point.
-    """
-    literally(code)
-    nx = X0.shape[0]
+    si, sf = settings.si, settings.sf
+    log, acc, fail_state, info = out.log, out.acc, out.fail_state, out.info
+    pp, cp, vp = pb.pp, cb.cp, cb.vp
+    rows, current = env.rows, env.current
+    nxp, nxc = pb.x0.shape[0], cb.x0.shape[0]
     n_steps, log_every, ctrl_every = si[SI_NSTEPS], si[SI_LOG_EVERY], si[SI_CTRL_EVERY]
     naux = si[SI_NAUX]
     dt = sf[SF_DT]
-    X = X0.copy()
-    Xs = np.empty(nx)
-    k1, k2, k3, k4 = np.zeros(nx), np.zeros(nx), np.zeros(nx), np.zeros(nx)
-    hold = np.zeros(3 + nx - NX_PLANT)
+    xp, xc = pb.x0.copy(), cb.x0.copy()
+    xpn, xcn = np.empty(nxp), np.empty(nxc)  # the state after a step, checked before it is taken
+    xps, xcs = np.empty(nxp), np.empty(nxc)
+    kp1, kp2, kp3, kp4 = np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp)
+    kc1, kc2, kc3, kc4 = np.zeros(nxc), np.zeros(nxc), np.zeros(nxc), np.zeros(nxc)
+    refm, work, scr = np.zeros((3, 3)), np.zeros(WORK_SIZE), np.zeros(SCRATCH_SIZE)
+    cmd, cmd_sample = np.zeros(plant.N_CMD), np.zeros(plant.N_CMD)  # noqa: F821
+    sat = 0  # saturation flags of the command in force
     tau1, tau = np.zeros(3), np.zeros(3)
     aux1, aux = np.zeros(max(naux, 1)), np.zeros(max(naux, 1))
-    refm = np.zeros((3, 3))
-    omega = np.zeros(5)
-    work = np.zeros(WORK_SIZE)
-    reuse = state_free_disturbance(d_rows)  # stage 3 may reuse stage 2's reference and omega
+    reuse = state_free_disturbance(env.rows)  # stage 3 may reuse stage 2's reference and omega
     row = 0
+    info[INFO_STEPS] = 0
     for k in range(n_steps + 1):
         t = k * dt
-        if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, hold
+        if (k & (STOP_POLL - 1)) == 0 and info[INFO_STOP] != 0:
+            record_stop(xp, xc, xp, xc, fail_state)
+            return CAUSE_INTERRUPTED, row, t
+        if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, allocate, hold
             eval_reference(ref_p, t, refm)
-            eta, nu = measure(X, noise, k // ctrl_every)
-            status = control(code, t, eta, nu, attitude(eta[3], eta[4]), X, refm, vp_nom, cp, tau1, k1, aux1, work)
-            if status == 0 and not _finite3(tau1):
+            eta_t, nu_t = plant.pose(xp)  # noqa: F821
+            eta, nu = measure(eta_t, nu_t, env.noise, k // ctrl_every)
+            status = law(t, eta, nu, attitude(eta[3], eta[4]), xc, refm, vp, cp, tau1, kc1, aux1, work)  # noqa: F821
+            if status == 0 and not finite3(tau1):
                 status = STATUS_NONFINITE_INPUT
             if status != 0:
-                return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
-            cmd = saturate((tau1[0], tau1[1], tau1[2]), sf, SF_ACT)
-            hold[0], hold[1], hold[2] = rate_limit(cmd, (hold[0], hold[1], hold[2]), sf, SF_ACT, ctrl_every * dt)
-            for i in range(NX_PLANT, nx):
-                hold[3 + i - NX_PLANT] = k1[i]
-        # stage 1 at (t, X): also the values that are logged and enter the metrics
-        att = attitude(X[3], X[4])
-        status = closed_loop_rhs(code, t, X, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur, hold,
-                                 k1, tau1, aux1, refm, omega, work, att, True, sf)
-        if status == 0 and not _finite3(tau1):
+                record_stop(xp, xc, xp, xc, fail_state)
+                return CAUSE_CONTROLLER + status, row, t
+            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt,  # noqa: F821
+                                 cmd_sample)
+            for i in range(cmd_sample.shape[0]):
+                cmd[i] = cmd_sample[i]
+            for i in range(nxc):  # the held controller derivative, for every stage until the next sample
+                kc2[i] = kc3[i] = kc4[i] = kc1[i]
+        # stage 1 at (t, x): also the values that are logged and enter the metrics
+        att = attitude(xp[3], xp[4])
+        status, flags = stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd,
+                              kp1, kc1, tau1, aux1, True)
+        if ctrl_every == 0:
+            sat = flags
+        if status == 0 and ctrl_every == 0 and not finite3(tau1):
             status = STATUS_NONFINITE_INPUT
         if status != 0:
-            return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
-        eta, nu = plant_state(X)
-        p1 = virtual_point(eta, att, vp_nom[ELL])
+            record_stop(xp, xc, xp, xc, fail_state)
+            return CAUSE_CONTROLLER + status, row, t
+        applied = plant.applied(xp, cmd, pp)  # noqa: F821
+        eta, nu = plant.pose(xp)  # noqa: F821
+        p1 = virtual_point(eta, att, vp[ELL])
         e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
         if k % log_every == 0 and row < log.shape[0]:
-            _log_row(log, row, t, X, tau1, refm, e, aux1, naux, k1, vp_nom)
+            log_row(log, row, t, xp, cmd, pp, applied, refm, e, aux1, naux, kp1, vp)
             row += 1
         if k == n_steps:
             break
-        metrics_update(acc, t, dt, e, (tau1[0], tau1[1], tau1[2]), sf[SF_WIN_T0], sf[SF_WIN_T1])
-        for i in range(nx):
-            Xs[i] = X[i] + 0.5 * dt * k1[i]
-        status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
-                                 hold, k2, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True, sf)
+        metrics_update(acc, t, dt, e, applied, sf[SF_WIN_T0], sf[SF_WIN_T1])
+        saturation_update(acc, t, dt, sat, sf[SF_WIN_T0], sf[SF_WIN_T1])
+        for i in range(nxp):
+            xps[i] = xp[i] + 0.5 * dt * kp1[i]
+        for i in range(nxc):
+            xcs[i] = xc[i] + 0.5 * dt * kc1[i]
+        status, _ = stage(t + 0.5 * dt, xps, xcs, attitude(xps[3], xps[4]), ctrl_every, cp, vp, pp, ref_p, rows,
+                          current, refm, work, scr, cmd, kp2, kc2, tau, aux, True)
         if status == 0:
-            for i in range(nx):
-                Xs[i] = X[i] + 0.5 * dt * k2[i]
-            status = closed_loop_rhs(code, t + 0.5 * dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows,
-                                     d_cur, hold, k3, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), not reuse, sf)
+            for i in range(nxp):
+                xps[i] = xp[i] + 0.5 * dt * kp2[i]
+            for i in range(nxc):
+                xcs[i] = xc[i] + 0.5 * dt * kc2[i]
+            status, _ = stage(t + 0.5 * dt, xps, xcs, attitude(xps[3], xps[4]), ctrl_every, cp, vp, pp, ref_p,
+                              rows, current, refm, work, scr, cmd, kp3, kc3, tau, aux, not reuse)
         if status == 0:
-            for i in range(nx):
-                Xs[i] = X[i] + dt * k3[i]
-            status = closed_loop_rhs(code, t + dt, Xs, ctrl_every, nx, cp, vp_nom, vp_true, ref_p, d_rows, d_cur,
-                                     hold, k4, tau, aux, refm, omega, work, attitude(Xs[3], Xs[4]), True, sf)
+            for i in range(nxp):
+                xps[i] = xp[i] + dt * kp3[i]
+            for i in range(nxc):
+                xcs[i] = xc[i] + dt * kc3[i]
+            status, _ = stage(t + dt, xps, xcs, attitude(xps[3], xps[4]), ctrl_every, cp, vp, pp, ref_p, rows,
+                              current, refm, work, scr, cmd, kp4, kc4, tau, aux, True)
         if status != 0:
-            return _fail(CAUSE_CONTROLLER + status, X, fail_state), row, t
-        for i in range(nx):
-            X[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-        cause = _state_cause(X, sf[SF_THETA_LIM], sf[SF_STATE_LIM])
+            record_stop(xp, xc, xp, xc, fail_state)
+            return CAUSE_CONTROLLER + status, row, t
+        for i in range(nxp):
+            xpn[i] = xp[i] + dt / 6.0 * (kp1[i] + 2.0 * kp2[i] + 2.0 * kp3[i] + kp4[i])
+        for i in range(nxc):
+            xcn[i] = xc[i] + dt / 6.0 * (kc1[i] + 2.0 * kc2[i] + 2.0 * kc3[i] + kc4[i])
+        info[INFO_STEPS] = k + 1
+        cause = state_cause(xpn, xcn, sf)
         if cause != CAUSE_NONE:
-            return _fail(cause, X, fail_state), row, t + dt
+            record_stop(xpn, xcn, xp, xc, fail_state)
+            return cause, row, t + dt
+        for i in range(nxp):
+            xp[i] = xpn[i]
+        for i in range(nxc):
+            xc[i] = xcn[i]
     return CAUSE_NONE, row, n_steps * dt
+
+
+@kernel_part("njit(nogil=True, parallel=True)")
+def run_many(pps, xp0s, cps, xc0s, vps, rowss, curs, noises, refs, sis, sfs, ncols, accs, fails, infos, causes,
+             t_stops):
+    """:func:`run` of ``len(pps)`` runs of identical array shapes in a ``prange`` loop, metrics only.
+
+    Row ``i`` of every stacked argument is run ``i``'s array; writes ``accs``, ``fails``,
+    ``infos``, ``causes`` and ``t_stops``.
+    """
+    for i in prange(pps.shape[0]):
+        log = np.empty((0, ncols))
+        cause, _, t_stop = run(PlantBundle(pps[i], xp0s[i]), ControllerBundle(cps[i], xc0s[i], vps[i]),
+                               EnvironmentBundle(rowss[i], curs[i], noises[i]), refs[i], Settings(sis[i], sfs[i]),
+                               Outputs(log, accs[i], fails[i], infos[i]))
+        causes[i] = cause
+        t_stops[i] = t_stop

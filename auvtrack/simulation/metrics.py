@@ -31,10 +31,11 @@ OFF_SETTLE = 12  # 9 values, index OFF_SETTLE + 3 * threshold + axis; NaN = neve
 OFF_ABOVE = 21  # 9 flags: was the latest in-window sample at or above the threshold
 OFF_TMAX, OFF_TEN, OFF_TV, OFF_TPREV = 30, 33, 36, 39
 OFF_DUR, OFF_NSTEP, OFF_GRID_K, OFF_HAVE_PREV = 42, 43, 44, 45
-METRICS_SIZE = 46
+OFF_SAT = 46  # 3 values: seconds in the window with the command of input j saturated
+METRICS_SIZE = 49
 
 _AXIS_KINDS = ("rmse", "iae", "itae", "max_abs") + tuple(f"settle_{s}" for s in SETTLE_LABELS)
-_INPUT_KINDS = ("max_abs_tau", "energy_tau", "tv_tau")
+_INPUT_KINDS = ("max_abs_tau", "energy_tau", "tv_tau", "t_sat_tau")
 METRIC_NAMES: tuple[str, ...] = tuple(f"{k}_{a}" for k in _AXIS_KINDS for a in AXES) + tuple(
     f"{k}_{j}" for k in _INPUT_KINDS for j in INPUTS)
 """Every metric name, in the order :func:`metrics_finalize` returns them."""
@@ -42,7 +43,7 @@ METRIC_NAMES: tuple[str, ...] = tuple(f"{k}_{a}" for k in _AXIS_KINDS for a in A
 METRIC_UNITS: dict[str, str] = {
     "rmse": "m", "iae": "m*s", "itae": "m*s^2", "max_abs": "m", "settle": "s",
     "max_abs_tau": "N (u) or N*m (q, r)", "energy_tau": "N^2*s (u) or N^2*m^2*s (q, r)",
-    "tv_tau": "N/s (u) or N*m/s (q, r)",
+    "tv_tau": "N/s (u) or N*m/s (q, r)", "t_sat_tau": "s",
 }
 """Units of each metric family (the name without its axis / input suffix)."""
 
@@ -121,6 +122,29 @@ def metrics_update(acc, t, dt, e, tau, t0, t1):
         acc[OFF_GRID_K] = k
 
 
+@njit_noalloc(inline="always")
+def saturation_update(acc, t, dt, flags, t0, t1):
+    """Add one step to the saturation times: bit j of ``flags`` set means input j's command was saturated.
+
+    Parameters
+    ----------
+    acc : numpy.ndarray
+        Accumulator initialised by :func:`metrics_init`, modified in place.
+    t, dt : float
+        Start and length of the step (s).
+    flags : int
+        Bitmask returned by the plant's allocation for this step.
+    t0, t1 : float
+        Metrics window (same rule as :func:`metrics_update`).
+    """
+    tol = TOL_FRACTION * dt
+    if flags == 0 or t < t0 - tol or t >= t1 - tol:
+        return
+    for j in range(3):
+        if (flags >> j) & 1:
+            acc[OFF_SAT + j] += dt
+
+
 def _empty_metrics() -> dict[str, float]:
     return {name: math.nan for name in METRIC_NAMES}
 
@@ -174,10 +198,13 @@ def metrics_finalize(acc: np.ndarray, t0: float, t_end: float) -> dict[str, floa
         out[f"energy_tau_{n}"] = float(acc[OFF_TEN + j])
     for j, n in enumerate(INPUTS):
         out[f"tv_tau_{n}"] = float(acc[OFF_TV + j]) / dur
+    for j, n in enumerate(INPUTS):
+        out[f"t_sat_tau_{n}"] = float(acc[OFF_SAT + j])
     return out
 
 
-def metrics_from_trajectory(t, e, tau, t0: float = 0.0, t1: float = math.inf) -> dict[str, float]:
+def metrics_from_trajectory(t, e, tau, t0: float = 0.0, t1: float = math.inf,
+                            saturated=None) -> dict[str, float]:
     """Reference (pure NumPy) implementation of the metrics on sampled arrays.
 
     Sample k stands for the interval ``[t[k], t[k+1])`` (rectangle rule, left point); the last
@@ -197,6 +224,8 @@ def metrics_from_trajectory(t, e, tau, t0: float = 0.0, t1: float = math.inf) ->
         Window start (s).
     t1 : float, optional
         Window end (s); ``inf`` for the end of the samples.
+    saturated : array_like of bool, optional
+        Shape (N, 3): whether each input's command was saturated at each sample (default: never).
 
     Returns
     -------
@@ -251,6 +280,11 @@ def metrics_from_trajectory(t, e, tau, t0: float = 0.0, t1: float = math.inf) ->
     idx = tv_sample_indices(tw, tol, t0)
     for j, n in enumerate(INPUTS):
         out[f"tv_tau_{n}"] = float(np.sum(np.abs(np.diff(tauw[idx, j])))) / dur
+    sat = np.zeros((t.size, 3), bool) if saturated is None else np.asarray(saturated, bool)
+    if sat.shape != (t.size, 3):
+        raise ValueError("expected saturated of shape (N, 3)")
+    for j, n in enumerate(INPUTS):
+        out[f"t_sat_tau_{n}"] = float(np.sum(dt[sat[:-1][win][:, j]]))
     return out
 
 
@@ -280,5 +314,5 @@ def tv_sample_indices(t: np.ndarray, tol: np.ndarray, t0: float) -> np.ndarray:
 
 
 __all__ = ["METRICS_SIZE", "METRIC_NAMES", "METRIC_UNITS", "AXES", "INPUTS", "SETTLE_THRESHOLDS",
-           "TV_GRID", "metrics_init", "metrics_update", "metrics_finalize", "metrics_from_trajectory",
+           "TV_GRID", "metrics_init", "metrics_update", "saturation_update", "metrics_finalize", "metrics_from_trajectory",
            "tv_sample_indices"]

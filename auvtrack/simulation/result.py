@@ -18,7 +18,7 @@ BASE_CHANNELS: tuple[str, ...] = ("t", "x", "y", "z", "theta", "psi", "u", "v", 
                                   "tau_u", "tau_q", "tau_r", "xd", "yd", "zd", "ex", "ey", "ez")
 """Channels every result starts with, in this order (SI units: s, m, rad, m/s, rad/s, N, N m)."""
 
-STATUSES = ("ok", "failed")
+STATUSES = ("ok", "failed", "interrupted")
 FAILURE_KEYS = ("time", "cause", "detail", "state")
 CSV_NAME, JSON_NAME, MAT_NAME = "trajectory.csv", "run.json", "trajectory.mat"
 MAT_RESERVED = ("channel_names", "scenario_json", "failure_json", "status", "metrics", "version")

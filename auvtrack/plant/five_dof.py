@@ -1,0 +1,103 @@
+"""The 5-DOF plant: the paper's eq. (1) driven directly by tau = [tau_u, tau_q, tau_r].
+
+States ``x`` (``NX = 10``): eta = (x, y, z, theta, psi) (m, rad; NED, roll neglected) and
+nu = (u, v, w, q, r) (m/s, rad/s; body).  Actuator command ``cmd`` (``N_CMD = 3``): the applied
+tau (N, N m, N m) after the magnitude saturation and, in sampled-data mode, the slew-rate limit
+of :mod:`auvtrack.plant.actuators`.  No extra logged channels.
+
+Packed parameters ``pp`` = [vp_true (13, layout of :mod:`auvtrack.plant.params`), tau_max (3),
+rate_max (3)]: the true vehicle (the scenario's ``[uncertainty]`` applied to its preset) and the
+actuator limits.  Disturbance: omega of :func:`auvtrack.environment.eval_disturbance`, with the
+current as the damping force on the relative velocity.
+
+This is ``plant.model = "5dof"``, the default: the same arithmetic as the engine before plants
+became pluggable (bit-identical trajectories, tested).
+
+References
+----------
+Paper eq. (1)-(4); Fossen, T. I. (2021), Handbook of Marine Craft Hydrodynamics and Motion
+Control, 2nd ed., ch. 8 (currents) and ch. 11 (actuator limits).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import njit_noalloc
+from ..environment import eval_disturbance
+from .actuators import ACT_SIZE, pack_actuator, rate_limit, saturate
+from .contract import CAUSE_PITCH, SF_THETA_LIM
+from .dynamics import nu_dot
+from .kinematics import eta_dot
+from .params import VP_SIZE
+from .registry import CompiledPlant
+
+NAME = "5dof"
+NX, N_CMD, N_LOG = 10, 3, 0
+PP_ACT = VP_SIZE  # actuator limits start here in pp
+
+
+@njit_noalloc
+def pose(x):
+    """(eta, nu) 5-tuples of the plant state."""
+    return (x[0], x[1], x[2], x[3], x[4]), (x[5], x[6], x[7], x[8], x[9])
+
+
+@njit_noalloc
+def accel5(dx):
+    """(u_dot, v_dot, w_dot, q_dot, r_dot) of a state derivative."""
+    return dx[5], dx[6], dx[7], dx[8], dx[9]
+
+
+@njit_noalloc
+def allocate(tau3, eta, nu, x, pp, prev, h, cmd):
+    """Applied tau: the command saturated and, for a sampling period h > 0, rate limited from ``prev``.
+
+    Returns the bitmask of the inputs whose command exceeded its magnitude limit.
+    """
+    c = saturate(tau3, pp, PP_ACT)
+    flags = int(c[0] != tau3[0]) | (int(c[1] != tau3[1]) << 1) | (int(c[2] != tau3[2]) << 2)
+    if h > 0.0:
+        c = rate_limit(c, (prev[0], prev[1], prev[2]), pp, PP_ACT, h)
+    cmd[0], cmd[1], cmd[2] = c
+    return flags
+
+
+@njit_noalloc
+def rhs(t, x, att, cmd, env, pp, scr, fresh, dx):
+    """dx = (eta_dot, nu_dot) of eq. (1) with the applied tau ``cmd`` and omega(t) cached in ``scr[0:5]``."""
+    eta, nu = pose(x)
+    if fresh:
+        eval_disturbance(env[0], env[1], t, eta, nu, pp, scr)
+    dx[0], dx[1], dx[2], dx[3], dx[4] = eta_dot(att, nu)
+    dx[5], dx[6], dx[7], dx[8], dx[9] = nu_dot(att, nu, (cmd[0], cmd[1], cmd[2]),
+                                               (scr[0], scr[1], scr[2], scr[3], scr[4]), pp)
+
+
+@njit_noalloc
+def applied(x, cmd, pp):
+    """The tau acting on the vehicle: the applied command itself."""
+    return cmd[0], cmd[1], cmd[2]
+
+
+@njit_noalloc
+def attitude_cause(x, sf):
+    """CAUSE_PITCH when |theta| exceeds ``sf[SF_THETA_LIM]`` (rad), else 0."""
+    return CAUSE_PITCH if abs(x[3]) > sf[SF_THETA_LIM] else 0
+
+
+@njit_noalloc
+def log_extra(x, cmd, pp, log, row, col):
+    """No extra channels."""
+    return
+
+
+def setup(scenario) -> CompiledPlant:
+    """Pack the true 5-DOF vehicle and actuator limits of ``scenario`` and its initial state."""
+    from .presets import vehicle_arrays
+
+    _, vp_true, record = vehicle_arrays(scenario)
+    act = scenario.actuator
+    pp = np.concatenate([vp_true, pack_actuator(act.tau_max, act.rate_max)])
+    assert pp.size == PP_ACT + ACT_SIZE
+    x0 = np.array([*scenario.initial.eta, *scenario.initial.nu], dtype=np.float64)
+    return CompiledPlant(pp=pp, x0=x0, resolved={"model": NAME, "vehicle": record})

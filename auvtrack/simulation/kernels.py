@@ -1,0 +1,391 @@
+"""Kernels per (controller, plant): generated from the engine's loop, compiled on demand, cached on disk.
+
+A kernel is the RK4 loop of :mod:`auvtrack.simulation.engine` with one controller's compiled
+law bound to the name ``law`` and one plant module bound to ``plant``.  :func:`kernel` writes a
+small module for the pair into the kernel cache folder (a verbatim copy of the engine's
+``@kernel_part`` functions under the decorators the engine names), imports it and returns its
+``run``.  Numba compiles it the first time it runs and caches it on disk next to it, so
+
+* only the pairs a run needs are ever compiled (a new controller or plant costs nothing until
+  used), and each pair gets its own specialised loop: the law is inlined, with no run-time
+  dispatch;
+* the folder is named by a hash of every package source (:func:`auvtrack._jit.cache_dir`); a
+  plug-in's kernel is also named by a hash of the plug-in file, so editing either selects fresh
+  kernels (a plug-in's own imports of other files are not hashed: see ``docs/plugins.md``);
+* :func:`warmup` compiles several pairs in parallel, one process each, and reports progress; a
+  run that has to compile says so first ("compiling kernels (first run only, about N s)").
+
+A controller's law is named by ``law``: an importable module name (``auvtrack.control.ftsmc``)
+or the path of a ``.py`` file (a plug-in), whose module defines ``control``.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib
+import importlib.util
+import inspect
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterable, Sequence
+
+from .. import _jit
+from . import engine
+
+__all__ = ["KernelKey", "kernel", "is_compiled", "warmup", "law_module", "kernel_source",
+           "compile_estimate"]
+
+COMPILE_ESTIMATE_S = 20.0  # shown before the first compile of a kernel when nothing was measured yet
+
+
+@dataclass(frozen=True)
+class KernelKey:
+    """One kernel: a controller law (module name or ``.py`` path) and a plant module name.
+
+    Attributes
+    ----------
+    law : str
+        ``"auvtrack.control.fxtntsmc"`` or ``"/abs/path/my_controller.py"``.
+    plant : str
+        ``"auvtrack.plant.five_dof"``.
+    label : str
+        Human name for messages, e.g. ``"fxtntsmc on 5dof"``.
+    """
+
+    law: str
+    plant: str
+    label: str = ""
+
+    @property
+    def is_file(self) -> bool:
+        """True when the law is a plug-in file."""
+        return self.law.endswith(".py")
+
+    @property
+    def name(self) -> str:
+        """Identifier of the generated module (also its file name)."""
+        if self.is_file:
+            path = Path(self.law).resolve()
+            digest = hashlib.sha256(path.read_bytes()).hexdigest()[:12]
+            law = f"plugin_{_ident(path.stem)}_{digest}"
+        else:
+            law = _ident(self.law.rsplit(".", 1)[-1])
+        return f"k_{law}__{_ident(self.plant.rsplit('.', 1)[-1])}"
+
+
+def _ident(text: str) -> str:
+    return re.sub(r"\W", "_", text)
+
+
+def law_module(law: str):
+    """Import the module holding a controller law.
+
+    Parameters
+    ----------
+    law : str
+        An importable module name, or the path of a ``.py`` file (imported once per content under a
+        name derived from its path and hash).
+
+    Returns
+    -------
+    module
+        The module; its ``control`` is the compiled law.
+
+    Raises
+    ------
+    ImportError
+        If the module or file cannot be imported (the message names it).
+    """
+    if not law.endswith(".py"):
+        return importlib.import_module(law)
+    path = Path(law).resolve()
+    if not path.is_file():
+        raise ImportError(f"{path}: no such file")
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()[:12]
+    name = f"auvtrack_plugin_{_ident(path.stem)}_{digest}"
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"{path}: not an importable Python file")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[name]
+        raise
+    return module
+
+
+def kernel_source(key: KernelKey) -> str:
+    """Python source of the generated kernel module of ``key``.
+
+    Parameters
+    ----------
+    key : KernelKey
+        The pair.
+
+    Returns
+    -------
+    str
+        A module binding ``law`` and ``plant`` followed by a copy of every ``@kernel_part`` of
+        :mod:`auvtrack.simulation.engine` under its decorator.
+    """
+    parts = []
+    for name, decorator in engine.KERNEL_PARTS.items():
+        src = inspect.getsource(getattr(engine, name))
+        lines = src.splitlines()
+        assert lines[0].startswith("@kernel_part("), f"engine.{name}: the marker must be the only decorator"
+        parts.append(f"@{decorator}\n" + "\n".join(lines[1:]) + "\n")
+    head = f'''"""Kernel of {key.label or key.name}: generated by auvtrack.simulation.kernels; do not edit.
+
+The loop is a copy of auvtrack/simulation/engine.py's kernel parts with ``law`` = {key.law}.control
+and ``plant`` = {key.plant}.
+"""
+from auvtrack._jit import njit, njit_noalloc  # noqa: F401
+from auvtrack.simulation.engine import *  # noqa: F401,F403
+from auvtrack.simulation.kernels import law_module
+from {key.plant.rsplit('.', 1)[0]} import {key.plant.rsplit('.', 1)[1]} as plant
+
+law = law_module({key.law!r}).control
+'''
+    return head + "\n\n" + "\n\n".join(parts)
+
+
+def _folder() -> Path:
+    folder = _jit.cache_dir() / "kernels"
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+def _write_if_changed(path: Path, text: str) -> None:
+    """Write ``text`` atomically unless the file already holds it (keeps its time stamp for Numba)."""
+    if path.is_file() and path.read_text() == text:
+        return
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}-", suffix=".tmp")
+    with os.fdopen(fd, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+_LOADED: dict[str, Callable] = {}
+_LOCK = threading.Lock()
+
+
+def _marker(key: KernelKey) -> Path:
+    return _folder() / f"{key.name}.compiled.json"
+
+
+def is_compiled(key: KernelKey) -> bool:
+    """True when the kernel of ``key`` is compiled in this process or cached on disk.
+
+    Parameters
+    ----------
+    key : KernelKey
+        The pair.
+
+    Returns
+    -------
+    bool
+        Whether running it needs no compilation.
+    """
+    loaded = _LOADED.get(key.name)
+    if loaded is not None and loaded.signatures:
+        return True
+    return _marker(key).is_file()
+
+
+def _module(key: KernelKey):
+    name = key.name
+    path = _folder() / f"{name}.py"
+    _write_if_changed(path, kernel_source(key))
+    modname = f"auvtrack_kernels.{name}"
+    if modname in sys.modules:
+        return sys.modules[modname]
+    spec = importlib.util.spec_from_file_location(modname, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def kernel_module(key: KernelKey):
+    """The generated module of ``key`` (its ``run`` and ``run_many``), imported on first use.
+
+    Parameters
+    ----------
+    key : KernelKey
+        The pair.
+
+    Returns
+    -------
+    module
+        The generated kernel module.
+    """
+    kernel(key)
+    return sys.modules[f"auvtrack_kernels.{key.name}"]
+
+
+def kernel(key: KernelKey) -> Callable:
+    """The compiled ``run`` of a (law, plant) pair (generated and imported on first use).
+
+    Parameters
+    ----------
+    key : KernelKey
+        The pair.
+
+    Returns
+    -------
+    callable
+        ``run(plant_bundle, controller_bundle, environment, ref_p, settings, outputs)``; it
+        compiles on its first call unless cached on disk.
+    """
+    with _LOCK:
+        fn = _LOADED.get(key.name)
+        if fn is None:
+            fn = _module(key).run
+            _LOADED[key.name] = fn
+        return fn
+
+
+def mark_compiled(key: KernelKey, seconds: float) -> None:
+    """Record that ``key`` is compiled and cached, and how long it took (for the next estimate)."""
+    _write_if_changed(_marker(key), json.dumps({"kernel": key.name, "seconds": round(seconds, 2)}))
+
+
+def compile_estimate() -> float:
+    """Seconds one kernel took to compile here the last times (median of the markers), or a default.
+
+    Returns
+    -------
+    float
+        The estimate shown by the compile notice.
+    """
+    times = []
+    root = _jit.cache_dir().parent
+    for marker in root.glob("*/kernels/*.compiled.json"):
+        try:
+            times.append(float(json.loads(marker.read_text())["seconds"]))
+        except (OSError, ValueError, KeyError):
+            continue
+    if not times:
+        return COMPILE_ESTIMATE_S
+    times.sort()
+    return times[len(times) // 2]
+
+
+def _compile_run(run) -> None:
+    """Compile ``run`` for the argument types every prepared run has (:func:`engine.example_arguments`)."""
+    import numba
+
+    run.compile(tuple(numba.typeof(a) for a in engine.example_arguments()))
+
+
+def _compile_in_process(key: KernelKey) -> float:
+    t0 = time.perf_counter()
+    _compile_run(kernel(key))
+    seconds = time.perf_counter() - t0
+    mark_compiled(key, seconds)
+    return seconds
+
+
+def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
+           notice: Callable[[str], None] | None = None, progress: bool = False) -> list[KernelKey]:
+    """Compile the kernels of ``keys`` that are not cached yet, several at once, and load them.
+
+    One missing kernel compiles in this process; several compile in child processes, ``jobs`` at
+    a time (Numba holds the GIL while compiling), and are then loaded from the disk cache.
+
+    Parameters
+    ----------
+    keys : iterable of KernelKey
+        The pairs needed.
+    jobs : int, optional
+        Processes compiling at once (default: usable cores).
+    notice : callable, optional
+        Receives the one-line "compiling kernels ..." notice (default: printed to stderr).
+    progress : bool, optional
+        Show a progress bar over the kernels being compiled.
+
+    Returns
+    -------
+    list of KernelKey
+        The keys that were compiled now.
+    """
+    todo = []
+    for k in keys:
+        if not is_compiled(k) and k not in todo:
+            todo.append(k)
+    if not todo:
+        return []
+    jobs = jobs or _cores()
+    per = compile_estimate()
+    waves = -(-len(todo) // max(1, jobs))
+    say = notice or (lambda text: print(text, file=sys.stderr, flush=True))
+    names = ", ".join(k.label or k.name for k in todo)
+    say(f"compiling kernels (first run only, about {per * waves:.0f} s): {names}")
+    bar = _bar(len(todo), progress)
+    try:
+        if len(todo) == 1 or jobs == 1:
+            for k in todo:
+                _compile_in_process(k)
+                bar.update(1)
+        else:
+            with ThreadPoolExecutor(max_workers=jobs) as pool:
+                for _ in pool.map(_compile_in_child, todo):
+                    bar.update(1)
+            for k in todo:  # load the cached machine code into this process
+                kernel(k)
+    finally:
+        bar.close()
+    return todo
+
+
+def _compile_in_child(key: KernelKey) -> None:
+    code = ("import sys, json; from auvtrack.simulation.kernels import KernelKey, _child_compile; "
+            "_child_compile(KernelKey(**json.loads(sys.argv[1])))")
+    arg = json.dumps({"law": key.law, "plant": key.plant, "label": key.label})
+    proc = subprocess.run([sys.executable, "-c", code, arg], capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"compiling {key.label or key.name} failed:\n{proc.stderr.strip()}")
+
+
+def _child_compile(key: KernelKey) -> None:
+    _compile_in_process(key)
+
+
+def _cores() -> int:
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+class _NoBar:
+    def update(self, n: int) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+def _bar(total: int, progress: bool):
+    if not progress:
+        return _NoBar()
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc="compiling", unit="kernel", leave=False)
+
+
+def keys_for(pairs: Sequence[tuple[str, str, str]]) -> list[KernelKey]:
+    """KernelKeys of (law, plant module, label) triples (helper for callers building many)."""
+    return [KernelKey(law, plant, label) for law, plant, label in pairs]
