@@ -160,7 +160,7 @@ def vehicle_arrays(sc) -> tuple[np.ndarray, np.ndarray, dict]:
     record : dict
         Preset, numbers, sources and the true plant's numbers, for ``run.json``.
     """
-    pre = get_preset(sc.vehicle.preset)
+    pre = get_preset(sc.vehicle.preset, u0=getattr(sc.vehicle, "u0", None))
     v = sc.vehicle
     m = np.array(v.m if v.m is not None else pre.m, dtype=float)
     d = np.array(v.d if v.d is not None else pre.d, dtype=float)
@@ -170,7 +170,7 @@ def vehicle_arrays(sc) -> tuple[np.ndarray, np.ndarray, dict]:
     vp_nom = pack_vehicle(m, d, wgml, ell, 1.0)
     vp_true = pack_vehicle(m * (1 + u.M), d * (1 + u.D), wgml * (1 + u.G), ell, 1.0 + u.C)
     record = {"preset": pre.name, "m": m.tolist(), "d": d.tolist(), "wgml": wgml, "l": ell,
-              "sources": pre.sources,
+              "sources": pre.sources, **({"u0": pre.u0} if pre.u0 is not None else {}),
               "true_plant": {"m": (m * (1 + u.M)).tolist(), "d": (d * (1 + u.D)).tolist(),
                              "wgml": wgml * (1 + u.G), "c_scale": 1.0 + u.C}}
     return vp_nom, vp_true, record

@@ -35,6 +35,10 @@ class CompiledPlant:
         Messages to show the user.
     resolved : dict
         JSON record of the plant actually simulated (numbers and their sources) for ``run.json``.
+    module : str
+        Importable name of the module whose compiled functions run this plant; empty = the
+        registered spec's module.  A plant with presets of different equations (``"6dof"``)
+        names the preset's module here, so each gets its own kernel.
     """
 
     pp: np.ndarray
@@ -42,6 +46,7 @@ class CompiledPlant:
     log_names: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
     resolved: dict[str, Any] = field(default_factory=dict)
+    module: str = ""
 
 
 @dataclass(frozen=True)

@@ -15,9 +15,9 @@ from ..environment.current import current_velocity
 from ..environment.disturbances import add_paper, add_pulse
 from ..environment.layout import KIND_CURRENT, KIND_PAPER, KIND_PULSE
 from .actuators6 import effective
+from .contract import CAUSE_PITCH, CAUSE_ROLL, SF_PHI_LIM, SF_THETA_LIM
 from .layout6 import CMD_DR, CMD_DS, CMD_N, CMD_TAU, P_DIRECT, P_DMAX, P_NMAX
 
-CAUSE_PITCH, CAUSE_ROLL = 2, 5
 SCR_DIST, SCR_VC = 0, 5  # scratch: disturbance forces (5), current velocity (3)
 
 
@@ -31,9 +31,6 @@ def pose(x):
 def accel5(dx):
     """(u_dot, v_dot, w_dot, q_dot, r_dot) from the state derivative."""
     return dx[6], dx[7], dx[8], dx[10], dx[11]
-
-
-SF_THETA_LIM, SF_PHI_LIM = 1, 6  # settings indices (engine v2); replaced by the engine's constants
 
 
 @njit_noalloc

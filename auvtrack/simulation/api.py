@@ -202,7 +202,8 @@ def prepare(scenario: Scenario) -> Prepared:
     if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
     noise = noise_table(sc.seed, n_steps // ctrl_every + 1 if ctrl_every else 1, sigma)
-    key = kernels.KernelKey(cc.law or cspec.module, plant_spec.module, f"{cspec.name} on {plant_spec.name}")
+    key = kernels.KernelKey(cc.law or cspec.module, cpl.module or plant_spec.module,
+                            f"{cspec.name} on {plant_spec.name}")
     return Prepared(
         scenario=sc, key=key,
         plant=PlantBundle(_c(cpl.pp), _c(cpl.x0)),
