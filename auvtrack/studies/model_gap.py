@@ -13,8 +13,8 @@ truth          what the controller does not know
 ``fossen``     ``remus100_fossen``: Fossen's spheroid model with its own hydrodynamics and actuators
 =============  ===================================================================
 
-over three references at REMUS speeds (a helix of 10 m radius at 1 m/s, a lawnmower survey at
-1 m/s with 20 m line spacing, a waypoint spline at 1 m/s), each with and without an ocean current
+over three references at REMUS speeds and turn radii (a helix of 30 m radius at 1 m/s, a lawnmower
+survey at 1 m/s with 60 m line spacing, a waypoint spline at 1 m/s), each with and without an ocean current
 (Gauss-Markov, mean (0.2, 0.1, 0) m/s NED, sigma 0.05 m/s, tau 60 s).  No disturbance force:
 the model gap is the disturbance.  The vehicle starts 0.5 m beside the reference's start at the
 reference speed, its propeller trimmed (:func:`auvtrack.plant.truth6.trim_rpm`).
@@ -38,12 +38,14 @@ from .report import Report, failure_cause, write_json
 
 TRUTHS = {"5dof": None, "prestero": "remus100_prestero", "fossen": "remus100_fossen"}
 CURRENT = {"kind": "current", "mean": [0.2, 0.1, 0.0], "sigma": [0.05, 0.05, 0.0], "tau": 60.0}
+# Turns no tighter than 30 m radius: Fossen's REMUS turns on ~21-24 m at full rudder (measured
+# open loop at 1-1.5 m/s), so every reference is within reach of both truths' fins.
 REFERENCES = {
-    "helix": {"kind": "helix", "radius": 10.0, "omega": 0.1, "climb": 0.05, "center": [-10.0, 0.0, 2.0]},
-    "lawnmower": {"kind": "lawnmower", "start": [0.0, 0.0], "heading": 0.0, "leg_length": 60.0,
-                  "spacing": 20.0, "legs": 3, "speed": 1.0, "depth": 5.0},
-    "waypoints": {"kind": "waypoints", "points": [[0.0, 0.0, 2.0], [40.0, 0.0, 4.0], [70.0, 25.0, 6.0],
-                                                  [50.0, 55.0, 6.0], [10.0, 50.0, 4.0]], "speed": 1.0},
+    "helix": {"kind": "helix", "radius": 30.0, "omega": 1.0 / 30.0, "climb": 0.05, "center": [-30.0, 0.0, 2.0]},
+    "lawnmower": {"kind": "lawnmower", "start": [0.0, 0.0], "heading": 0.0, "leg_length": 80.0,
+                  "spacing": 60.0, "legs": 3, "speed": 1.0, "depth": 5.0},
+    "waypoints": {"kind": "waypoints", "points": [[0.0, 0.0, 2.0], [60.0, 0.0, 4.0], [110.0, 30.0, 6.0],
+                                                  [110.0, 90.0, 6.0], [60.0, 120.0, 4.0]], "speed": 1.0},
 }
 ELL = 1.0  # m, virtual-point offset (remus100 preset)
 
@@ -108,21 +110,27 @@ def summarise(job: tuple, res, limits: dict | None) -> dict:
     T = t[-1] if t.size else 0.0
     row = {"controller": kind, "truth": truth, "reference": ref, "current": current, "status": res.status,
            "cause": failure_cause(res), "fail_time": res.failure["time"] if res.failure else None}
+    if t.size == 0:  # stopped before the first logged row
+        row.update(rmse_late=None, max_e_late=None, max_theta_deg=None)
+        row["duration_run"] = 0.0
+        return row
     e = np.sqrt(ch["ex"] ** 2 + ch["ey"] ** 2 + ch["ez"] ** 2)
-    late = t >= t[-1] / 2 if t.size else t
-    row["rmse_late"] = float(np.sqrt(np.mean(e[late] ** 2))) if np.any(late) else None
-    row["max_e_late"] = float(e[late].max()) if np.any(late) else None
-    row["max_theta_deg"] = float(np.degrees(np.abs(ch["theta"]).max())) if t.size else None
+    late = t >= t[-1] / 2
+    row["rmse_late"] = float(np.sqrt(np.mean(e[late] ** 2)))
+    row["max_e_late"] = float(e[late].max())
+    row["max_theta_deg"] = float(np.degrees(np.abs(ch["theta"]).max()))
     if limits is not None and "delta_r" in ch:
         dt = np.diff(t)
         for name, lim in (("delta_r", limits["delta_max"]), ("delta_s", limits["delta_max"]), ("rpm", limits["n_max"])):
-            sat = _at_limit(ch[name], lim)
-            row[f"sat_frac_{name}"] = float(np.mean(sat)) if t.size else None
+            row[f"sat_frac_{name}"] = float(np.mean(_at_limit(ch[name], lim)))
         for name in ("delta_r", "delta_s"):
-            rate = np.abs(np.diff(ch[name])) / dt if dt.size else np.zeros(0)
-            row[f"rate_rms_{name}"] = float(np.sqrt(np.mean(rate ** 2))) if rate.size else None
-            row[f"rate_max_{name}"] = float(rate.max()) if rate.size else None
+            rate = np.abs(np.diff(ch[name])) / dt if dt.size else np.zeros(1)
+            row[f"rate_rms_{name}"] = float(np.sqrt(np.mean(rate ** 2)))
+            row[f"rate_max_{name}"] = float(rate.max())
         row["max_phi_deg"] = float(np.degrees(np.abs(ch["phi"]).max()))
+    for j in "uqr":  # the engine's time with tau_j unproducible (allocation's saturation flags), s
+        v = res.metrics.get(f"t_sat_tau_{j}")
+        row[f"t_sat_tau_{j}"] = float(v) if v is not None and math.isfinite(v) else None
     row["duration_run"] = float(T)
     return row
 
@@ -136,7 +144,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
         Output folder (created).
     quick : bool, optional
         The helix without current, 20 s runs (CI) instead of every reference with and without
-        current, 120 s.
+        current, 150 s.
     progress : bool, optional
         Show a progress bar.
 
@@ -149,7 +157,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     from ..simulation.api import prepare, run_prepared
 
     out = Path(out)
-    duration = 20.0 if quick else 120.0
+    duration = 20.0 if quick else 150.0
     rows = []
     for job in tqdm(jobs(quick), disable=not progress, desc="model-gap"):
         sc = load_scenario(scenario(*job, duration))
@@ -163,16 +171,20 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     rep.paragraph(
         f"Design model: `remus100` (5-DOF, reduced at the reference's speed). Truths: its own 5-DOF model "
         f"(no uncertainty), `remus100_prestero`, `remus100_fossen` (6-DOF, fins and propeller through the "
-        f"control allocation). {duration:g} s runs; errors over the second half. Current: "
+        f"control allocation). {duration:g} s runs; errors and the time with tau unproducible (the "
+        f"allocation's saturation flags) over the second half; fins / rpm at limit and fin rates over the "
+        f"whole run (fractions of the logged samples). Current: "
         f"Gauss-Markov, mean {CURRENT['mean']} m/s, sigma {CURRENT['sigma']} m/s.")
     rep.heading("Failures by cause")
     rep.table(["controller", "truth", "runs", "failed", "causes"], _failure_table(rows))
     rep.heading("Runs")
     rep.table(["controller", "truth", "reference", "current", "status", "rmse late (m)", "max |e| late (m)",
-               "max |theta| (deg)", "max |phi| (deg)", "fins at limit (r / s)", "rpm at limit", "fin rate rms (rad/s)"],
+               "max |theta| (deg)", "max |phi| (deg)", "tau unproducible u / q / r (s)", "fins at limit (r / s)",
+               "rpm at limit", "fin rate rms r / s (rad/s)"],
               [[r["controller"], r["truth"], r["reference"], "yes" if r["current"] else "no",
                 "ok" if r["status"] == "ok" else f"failed: {r['cause']} at {r['fail_time']:.3g} s",
                 r["rmse_late"], r["max_e_late"], r["max_theta_deg"], r.get("max_phi_deg"),
+                " / ".join("–" if r.get(f"t_sat_tau_{j}") is None else f"{r[f't_sat_tau_{j}']:.3g}" for j in "uqr"),
                 _pair(r.get("sat_frac_delta_r"), r.get("sat_frac_delta_s")), r.get("sat_frac_rpm"),
                 _pair(r.get("rate_rms_delta_r"), r.get("rate_rms_delta_s"))] for r in rows], digits=3)
     return rep.write()
