@@ -2,7 +2,7 @@
 
 Registering a built-in controller is one line: its module in :data:`BUILTIN`.
 """
-from . import ftsmc, fxtntsmc, open_loop
+from . import ftsmc, fxtntsmc, open_loop, open_loop_actuators
 from .params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
 from .registry import CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, get, register
 
@@ -10,6 +10,7 @@ BUILTIN = (
     fxtntsmc,
     ftsmc,
     open_loop,
+    open_loop_actuators,
 )
 for _module in BUILTIN:
     register(ControllerSpec.from_module(_module))

@@ -564,7 +564,18 @@ class Scenario(BaseModel):
                 if any(math.isfinite(x) for x in v):
                     raise ValueError(f"actuator.{k}: limits the 5-DOF input only; with plant.model = \"6dof\" the fins "
                                      f"and propeller limit it (plant.delta_max, plant.n_max, ...) (got {format_value(v)})")
+            if self.controller.kind == "open_loop_actuators":
+                lim = self.plant.actuator_limits()
+                for k, cap, key in (("delta_r", lim["delta_max"], "delta_max"), ("delta_s", lim["delta_max"], "delta_max"),
+                                    ("rpm", lim["n_max"], "n_max")):
+                    v = getattr(self.controller, k)
+                    if abs(v) > cap:
+                        raise ValueError(f"controller.{k}: beyond the actuator limit plant.{key} = {cap:.6g} "
+                                         f"(got {format_value(v)})")
         else:
+            if self.controller.kind == "open_loop_actuators":
+                raise ValueError("controller.kind: open_loop_actuators commands fins and propeller; it needs "
+                                 "plant.model = \"6dof\" (got 'open_loop_actuators' with plant.model \"5dof\")")
             for k in ("phi", "p"):
                 if getattr(self.initial, k) != 0.0:
                     raise ValueError(f"initial.{k}: roll exists only with plant.model = \"6dof\" "

@@ -120,3 +120,112 @@ def zigzag_metrics(t, psi, delta_r, psi_switch: float, t0: float = 0.0) -> dict:
     return {"initial_turning_time": float(times[0] - t[0]) if times else math.nan,
             "period": float(times[2] - times[0]) if len(times) >= 3 else math.nan,
             "overshoot_1": over[0], "overshoot_2": over[1], "reversals": len(times)}
+
+
+# --- the study: both 6-DOF presets through the packaged example scenarios --------------------------
+
+PRESETS = ("remus100_prestero", "remus100_fossen")
+SCENARIOS = {"turning_circle": "remus100_turning_circle.toml", "zigzag": "remus100_zigzag.toml"}
+
+
+def scenario_path(which: str):
+    """Path of a packaged example scenario (``auvtrack/data/scenarios``): turning_circle or zigzag."""
+    from importlib import resources
+    return resources.files("auvtrack") / "data" / "scenarios" / SCENARIOS[which]
+
+
+def run(out, *, quick: bool = False, progress: bool = False):
+    """Run the turning circle and the zig-zag on both 6-DOF presets; write report, figures, results.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Output folder (created).
+    quick : bool, optional
+        40 s instead of the scenarios' 120 s.
+    progress : bool, optional
+        Unused (few runs).
+
+    Returns
+    -------
+    pathlib.Path
+        The report's path.
+    """
+    from pathlib import Path
+
+    from matplotlib.figure import Figure
+
+    from ..scenario import load_scenario
+    from ..simulation.api import prepare, run_prepared
+    from .report import Report, write_json
+
+    out = Path(out)
+    runs, rows = {}, []
+    for which in SCENARIOS:
+        for preset in PRESETS:
+            sets = [f"plant.preset={preset}"] + (["sim.duration=40"] if quick else [])
+            sc = load_scenario(scenario_path(which), sets)
+            res = run_prepared(prepare(sc))
+            ch = res.channels
+            t0 = sc.controller.t_execute
+            if which == "turning_circle":
+                m = turning_circle_metrics(ch["t"], ch["x"], ch["y"], ch["psi"], ch["u"], ch["v"], ch["r"], t0)
+            else:
+                m = zigzag_metrics(ch["t"], ch["psi"], ch["delta_r"], sc.controller.zigzag_psi, t0)
+            runs[(which, preset)] = (sc, ch)
+            rows.append({"manoeuvre": which, "preset": preset, "status": res.status, **m,
+                         "speed_end": float(ch["u"][-1]), "max_theta_deg": float(np.degrees(np.abs(ch["theta"]).max())),
+                         "max_phi_deg": float(np.degrees(np.abs(ch["phi"]).max()))})
+    write_json(out / "results.json", {"rows": rows, "quick": quick})
+    rep = Report(out, "Manoeuvres of the REMUS 100 truth models: turning circle and zig-zag")
+    rep.paragraph("Open-loop (controller `open_loop_actuators`), from straight running at 1.5 m/s with the "
+                  "propeller trimmed; rudder put over at 5 s. Scenarios: `scenarios/remus100_turning_circle.toml`, "
+                  "`scenarios/remus100_zigzag.toml` (`--set plant.preset=...`). Metrics per ITTC 7.5-04-02-01. "
+                  "P01's REMUS is open-loop unstable (docs/vehicles.md): it does not settle on a circle of the "
+                  "rudder's making but spirals down, nose-down, losing speed.")
+    fig = Figure(figsize=(10, 4.6))
+    axes = fig.subplots(1, 2)
+    for ax, preset in zip(axes, PRESETS):
+        _, ch = runs[("turning_circle", preset)]
+        ax.plot(ch["y"], ch["x"], lw=1.2)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("east y (m)")
+        ax.set_ylabel("north x (m)")
+        ax.set_title(preset)
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    rep.figure(fig, "turning_circle", "turning circle tracks (rudder 15 deg at 5 s)")
+    fig = Figure(figsize=(10, 5.6))
+    axes = fig.subplots(2, 1, sharex=True)
+    for preset in PRESETS:
+        _, ch = runs[("zigzag", preset)]
+        axes[0].plot(ch["t"], np.degrees(np.unwrap(ch["psi"]) - ch["psi"][0]), label=preset)
+        axes[1].plot(ch["t"], np.degrees(ch["delta_r"]), label=preset)
+    axes[0].set_ylabel("heading change (deg)")
+    axes[1].set_ylabel("rudder (deg)")
+    axes[1].set_xlabel("t (s)")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    rep.figure(fig, "zigzag", "zig-zag 15/20: heading change and rudder angle")
+    rep.heading("Turning circle")
+    rep.table(["preset", "status", "advance (m)", "transfer (m)", "tactical diameter (m)", "steady diameter (m)",
+               "speed at end (m/s)", "max \\|theta\\| (deg)"],
+              [[r["preset"], r["status"], r["advance"], r["transfer"], r["tactical_diameter"], r["steady_diameter"],
+                r["speed_end"], r["max_theta_deg"]] for r in rows if r["manoeuvre"] == "turning_circle"], digits=3)
+    rep.heading("Zig-zag")
+    rep.table(["preset", "status", "initial turning time (s)", "period (s)", "1st overshoot (deg)", "2nd overshoot (deg)",
+               "speed at end (m/s)"],
+              [[r["preset"], r["status"], r["initial_turning_time"], r["period"], math.degrees(r["overshoot_1"]),
+                math.degrees(r["overshoot_2"]), r["speed_end"]] for r in rows if r["manoeuvre"] == "zigzag"], digits=3)
+    return rep.write()
+
+
+def _spec():
+    from .registry import StudySpec
+    return StudySpec("manoeuvres", run, "turning circle and zig-zag of the 6-DOF REMUS 100 truth models "
+                     "(ITTC metrics, standard figures)")
+
+
+STUDY = _spec()

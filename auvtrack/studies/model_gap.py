@@ -178,8 +178,8 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     rep.heading("Failures by cause")
     rep.table(["controller", "truth", "runs", "failed", "causes"], _failure_table(rows))
     rep.heading("Runs")
-    rep.table(["controller", "truth", "reference", "current", "status", "rmse late (m)", "max |e| late (m)",
-               "max |theta| (deg)", "max |phi| (deg)", "tau unproducible u / q / r (s)", "fins at limit (r / s)",
+    rep.table(["controller", "truth", "reference", "current", "status", "rmse late (m)", "max \\|e\\| late (m)",
+               "max \\|theta\\| (deg)", "max \\|phi\\| (deg)", "tau unproducible u / q / r (s)", "fins at limit (r / s)",
                "rpm at limit", "fin rate rms r / s (rad/s)"],
               [[r["controller"], r["truth"], r["reference"], "yes" if r["current"] else "no",
                 "ok" if r["status"] == "ok" else f"failed: {r['cause']} at {r['fail_time']:.3g} s",
