@@ -111,15 +111,22 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
                    "writes benchmarks/results.{json,md} (or --out).")
 @click.option("--out", "bench_out", type=click.Path(file_okay=False), default=None,
               help="Folder for the --all results (default: benchmarks/ of the source tree, else .).")
-def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
+@click.option("--plant", type=click.Choice(["5dof", "6dof"]), default="5dof", show_default=True,
+              help="Plant model: 5dof (Section 4) or 6dof (each REMUS 100 truth preset, a 1 m/s line).")
+def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None,
+          plant: str) -> None:
     """Time the compiled closed loop; one JSON line per controller with us_per_step."""
-    from .runner.bench import bench_single
+    from .runner.bench import bench_plant, bench_single
 
     if run_all:
         from .runner.bench import bench_all
 
         doc = bench_all(repeat=repeat, out=Path(bench_out) if bench_out else None, progress=True)
         click.echo(json.dumps(doc, indent=2))
+        return
+    if plant != "5dof":  # issue 11: the 6-DOF truths, one line per (controller, preset)
+        for row in bench_plant(controllers or ("ftsmc", "fxtntsmc"), plant, repeat=repeat, duration=duration):
+            click.echo(json.dumps(row))
         return
     for kind in controllers or ("ftsmc", "fxtntsmc"):
         click.echo(json.dumps(bench_single(kind, repeat=repeat, duration=duration)))
