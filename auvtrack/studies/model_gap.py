@@ -13,8 +13,8 @@ truth          what the controller does not know
 ``fossen``     ``remus100_fossen``: Fossen's spheroid model with its own hydrodynamics and actuators
 =============  ===================================================================
 
-over three references at REMUS speeds and turn radii (a helix of 30 m radius at 1 m/s, a lawnmower
-survey at 1 m/s with 60 m line spacing, a waypoint spline at 1 m/s), each with and without an ocean current
+over three references at a REMUS speed and turn radius both truths can fly (1.25 m/s, turns of
+30 m radius or wider: a helix, a lawnmower survey with 60 m line spacing, a waypoint spline), each with and without an ocean current
 (Gauss-Markov, mean (0.2, 0.1, 0) m/s NED, sigma 0.05 m/s, tau 60 s).  No disturbance force:
 the model gap is the disturbance.  The vehicle starts 0.5 m beside the reference's start at the
 reference speed, its propeller trimmed (:func:`auvtrack.plant.truth6.trim_rpm`).
@@ -38,14 +38,17 @@ from .report import Report, failure_cause, write_json
 
 TRUTHS = {"5dof": None, "prestero": "remus100_prestero", "fossen": "remus100_fossen"}
 CURRENT = {"kind": "current", "mean": [0.2, 0.1, 0.0], "sigma": [0.05, 0.05, 0.0], "tau": 60.0}
-# Turns no tighter than 30 m radius: Fossen's REMUS turns on ~21-24 m at full rudder (measured
-# open loop at 1-1.5 m/s), so every reference is within reach of both truths' fins.
+# Speed and turn radius within both truths' reach: Fossen's REMUS turns on ~21-24 m at full rudder
+# (open loop, 1-1.5 m/s), so no turn is tighter than 30 m; P01's REMUS, 7 N positively buoyant,
+# cannot hold depth with 15 deg stern planes much below ~1.1 m/s and its propeller (thrust scaled
+# from P01's 3.86 N at 1500 rpm) tops out near 1.55 m/s, so every reference runs at 1.25 m/s.
+SPEED = 1.25  # m/s
 REFERENCES = {
-    "helix": {"kind": "helix", "radius": 30.0, "omega": 1.0 / 30.0, "climb": 0.05, "center": [-30.0, 0.0, 2.0]},
+    "helix": {"kind": "helix", "radius": 30.0, "omega": SPEED / 30.0, "climb": 0.05, "center": [-30.0, 0.0, 2.0]},
     "lawnmower": {"kind": "lawnmower", "start": [0.0, 0.0], "heading": 0.0, "leg_length": 80.0,
-                  "spacing": 60.0, "legs": 3, "speed": 1.0, "depth": 5.0},
+                  "spacing": 60.0, "legs": 3, "speed": SPEED, "depth": 5.0},
     "waypoints": {"kind": "waypoints", "points": [[0.0, 0.0, 2.0], [60.0, 0.0, 4.0], [110.0, 30.0, 6.0],
-                                                  [110.0, 90.0, 6.0], [60.0, 120.0, 4.0]], "speed": 1.0},
+                                                  [110.0, 90.0, 6.0], [60.0, 120.0, 4.0]], "speed": SPEED},
 }
 ELL = 1.0  # m, virtual-point offset (remus100 preset)
 
