@@ -303,8 +303,10 @@ def test_controller_union_covers_registry():
 
     kinds = {m.model_fields["kind"].default for m in CONTROLLER_MODELS}
     assert kinds == set(CONTROLLERS)
+    needs_6dof = {"open_loop_actuators"}  # commands fins and propeller (issue 11)
     for kind in kinds:
-        assert load_scenario({}, [f"controller.kind={kind}"]).controller.kind == kind
+        extra = ["plant.model=6dof"] if kind in needs_6dof else []
+        assert load_scenario({}, [f"controller.kind={kind}", *extra]).controller.kind == kind
 
 
 def test_frozen():
