@@ -54,10 +54,9 @@ ELL = 1.0  # m, virtual-point offset (remus100 preset)
 
 
 def controllers() -> list[str]:
-    """Tracking controllers to compare: every registered kind except the open-loop ones."""
-    from ..scenario.schema import CONTROLLER_MODELS
-    kinds = [m.model_fields["kind"].default for m in CONTROLLER_MODELS]
-    return [k for k in kinds if not k.startswith("open_loop")]
+    """Tracking controllers to compare: every built-in kind except the open-loop ones (and plug-ins)."""
+    from ..control import BUILTIN
+    return [m.NAME for m in BUILTIN if not m.NAME.startswith("open_loop")]
 
 
 def start_pose(ref_spec: dict, ell: float = ELL) -> tuple[list[float], list[float]]:
