@@ -40,7 +40,8 @@ def builtin_controllers() -> tuple[str, ...]:
     """Kinds of the built-in controllers (``auvtrack.control.BUILTIN``; the plug-in loader is not one)."""
     from ..control import BUILTIN
 
-    return tuple(m.NAME for m in BUILTIN)
+    # open_loop_actuators drives a 6-DOF plant's fins and propeller (issue 11): not on Section 4
+    return tuple(m.NAME for m in BUILTIN if m.NAME != "open_loop_actuators")
 
 
 def plugin_copy(kind: str, folder: Path) -> Path:
