@@ -10,15 +10,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from auvtrack.plant import fossen_remus, prestero
-from auvtrack.plant.actuators6 import effective
+from auvtrack.plant.sixdof import fossen, prestero
+from auvtrack.plant.sixdof.actuators import effective
 from auvtrack.plant.kinematics import attitude
-from auvtrack.plant.layout6 import (CMD_DR, CMD_DS, CMD_N, NX6, P_B, P_DMAX, P_MA, P_MINV, P_MODEL,
+from auvtrack.plant.sixdof.layout import (CMD_DR, CMD_DS, CMD_N, NX6, P_B, P_DMAX, P_MA, P_MINV, P_MODEL,
                                     P_MRB, P_NMAX, P_W, PP6_SIZE)
-from auvtrack.plant.presets6 import SHIPPED6, available6, load_preset6
-from auvtrack.plant.rigid6 import (euler_rates, kirchhoff, ned_velocity, body_from_ned6, rotation,
+from auvtrack.plant.sixdof.presets import SHIPPED6, available6, load_preset6
+from auvtrack.plant.sixdof.rigid import (euler_rates, kirchhoff, ned_velocity, body_from_ned6, rotation,
                                    skew, trig6)
-from auvtrack.plant.truth6 import MODELS, initial_state, integrate_open_loop, pack_truth
+from auvtrack.plant.sixdof.truth import MODELS, initial_state, integrate_open_loop, pack_truth
 
 DATA = Path(__file__).parent / "data"
 angles = st.tuples(st.floats(-math.pi, math.pi), st.floats(-1.4, 1.4), st.floats(-math.pi, math.pi))
@@ -99,7 +99,7 @@ def test_prestero_mass_matrix_entries():
 
 def test_fossen_rigid_body_matches_the_cg_transformation():
     """M_RB about the CO = H(r_g)^T M_CG H(r_g) (Fossen 2021 eq. 3.42) and Lamb's factors in (0, 1)."""
-    dd = fossen_remus.derived(load_preset6("remus100_fossen"))
+    dd = fossen.derived(load_preset6("remus100_fossen"))
     H = np.eye(6)
     H[0:3, 3:6] = skew([0.0, 0.0, 0.02]).T
     M_cg = np.diag([dd["m"]] * 3 + [dd["Ix"], dd["Iy"], dd["Iy"]])
@@ -117,10 +117,10 @@ def _conservative(name: str) -> np.ndarray:
     if name == "remus100_prestero":
         pp[P_MODEL:prestero.R_N0] = 0.0          # drag, lift, fins, thrust and torque
     else:
-        pp[fossen_remus.FZ_S] = pp[fossen_remus.FZ_CCF] = 0.0   # hull lift/drag, cross-flow
-        pp[fossen_remus.FZ_D0:fossen_remus.FZ_D0 + 6] = 0.0       # linear damping
-        pp[fossen_remus.FZ_KR] = pp[fossen_remus.FZ_KS] = 0.0     # fins
-        pp[fossen_remus.FZ_KT0:fossen_remus.FZ_KQMAX + 1] = 0.0   # propeller
+        pp[fossen.FZ_S] = pp[fossen.FZ_CCF] = 0.0   # hull lift/drag, cross-flow
+        pp[fossen.FZ_D0:fossen.FZ_D0 + 6] = 0.0       # linear damping
+        pp[fossen.FZ_KR] = pp[fossen.FZ_KS] = 0.0     # fins
+        pp[fossen.FZ_KT0:fossen.FZ_KQMAX + 1] = 0.0   # propeller
     return pp
 
 
@@ -301,7 +301,7 @@ def test_fin_rate_limit_acts():
     dx = np.zeros(NX6)
     cmd = np.zeros(6)
     cmd[CMD_DR] = 0.2
-    fossen_remus.derivative(x, attitude(0.0, 0.0), (0.0, 0.0, 0.0), (0.0,) * 6, cmd, pp, dx)
+    fossen.derivative(x, attitude(0.0, 0.0), (0.0, 0.0, 0.0), (0.0,) * 6, cmd, pp, dx)
     assert dx[12] == 0.05  # (0.2 - 0)/0.1 = 2 rad/s limited to 0.05
 
 
@@ -320,8 +320,8 @@ def _alloc(name, tau, nu, pp):
         bits = prestero.allocate_tau(*tau, nu[0], pp, cmd)
         prod = prestero.produced(nu[0], cmd[CMD_DR], cmd[CMD_DS], cmd[CMD_N], pp)
     else:
-        bits = fossen_remus.allocate_tau(*tau, *nu, pp, cmd)
-        prod = fossen_remus.produced(*nu, cmd[CMD_DR], cmd[CMD_DS], cmd[CMD_N], pp)
+        bits = fossen.allocate_tau(*tau, *nu, pp, cmd)
+        prod = fossen.produced(*nu, cmd[CMD_DR], cmd[CMD_DS], cmd[CMD_N], pp)
     return bits, cmd, np.array(prod)
 
 
@@ -358,7 +358,7 @@ def test_allocation_saturates_and_reports(name):
 
 @pytest.mark.parametrize("name", SHIPPED6)
 def test_trim_rpm_balances_surge(name):
-    from auvtrack.plant.truth6 import trim_rpm
+    from auvtrack.plant.sixdof.truth import trim_rpm
     pp = pack_truth(name)
     n = trim_rpm(name, pp, 1.0)
     x = initial_state(nu6=(1.0, 0, 0, 0, 0, 0), actuators=(0.0, 0.0, n))

@@ -63,7 +63,7 @@ def test_every_shipped_preset_is_available():
 # --- the reduction of remus100_prestero at a speed U0 (issue 13, point 6) -------------------------
 
 def test_reduction_is_computed_from_the_6dof_data_at_u0():
-    from auvtrack.plant.presets6 import load_preset6
+    from auvtrack.plant.sixdof.presets import load_preset6
     from auvtrack.plant.reduction import reduce_prestero
     v = load_preset6("remus100_prestero").values
     for u0 in (0.3, 0.41, 1.5, 2.0):

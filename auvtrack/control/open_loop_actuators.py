@@ -3,7 +3,7 @@
 The controller commands the actuators directly (the plant's allocation passes them through):
 propeller speed ``rpm`` (rpm), stern-plane angle ``delta_s`` and rudder angle ``delta_r`` (rad,
 in the plant preset's sign convention, docs/vehicles.md), the rudder put over at ``t_execute``;
-with ``rpm_trim`` the propeller holds the initial surge speed (:func:`auvtrack.plant.truth6.trim_rpm`).
+with ``rpm_trim`` the propeller holds the initial surge speed (:func:`auvtrack.plant.sixdof.truth.trim_rpm`).
 
 Zig-zag (``zigzag_psi > 0``, the ITTC Z-manoeuvre): the rudder is ``s * delta_r`` with a relay
 state s = +-1 reversed each time the heading change psi - psi0 reaches +-zigzag_psi against the
@@ -74,7 +74,7 @@ def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
 
 def rudder_turn_sign(preset: str) -> float:
     """Sign of the yaw moment (hence of the heading change) a positive rudder angle gives on ``preset``."""
-    from ..plant.truth6 import MODELS, pack_truth
+    from ..plant.sixdof.truth import MODELS, pack_truth
     model, pp = MODELS[preset], pack_truth(preset)
     if preset == "remus100_prestero":
         tr = model.produced(1.0, 0.1, 0.0, 0.0, pp)[2]
@@ -92,7 +92,7 @@ def setup(scenario, ctx) -> CompiledController:
     d = rudder_turn_sign(scenario.plant.preset) * (1.0 if p.delta_r >= 0 else -1.0)
     rpm = p.rpm
     if p.rpm_trim:
-        from ..plant.truth6 import pack_truth, trim_rpm
+        from ..plant.sixdof.truth import pack_truth, trim_rpm
         rpm = trim_rpm(scenario.plant.preset, pack_truth(scenario.plant.preset, scenario.plant.actuator_overrides()),
                        scenario.initial.nu[0])
     cp = np.array([rpm, p.delta_s, p.delta_r, p.zigzag_psi, scenario.initial.eta[4], d, p.t_execute],

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .presets6 import load_preset6
+from .sixdof.presets import load_preset6
 
 SOURCE_6DOF = "remus100_prestero"
 U0_MIN, U0_MAX = 0.05, 3.0  # m/s: the range a linearisation speed may take

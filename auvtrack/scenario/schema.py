@@ -18,9 +18,9 @@ from ..control import CONTROLLERS
 from ..control.params import FXTNTSMCParams, available_gain_presets, get_gain_preset
 from ..environment.current import MAX_SAMPLES as MAX_CURRENT_SAMPLES
 from ..plant.presets import available, get_preset, is_reduced
-from ..plant.presets6 import available6, load_preset6
+from ..plant.sixdof.presets import available6, load_preset6
 from ..plant.reduction import U0_MAX, U0_MIN, default_u0
-from ..plant.truth6 import actuator_values
+from ..plant.sixdof.truth import actuator_values
 from ..reference import build_reference
 
 DEFAULT_PLANT_PRESET = "remus100_prestero"

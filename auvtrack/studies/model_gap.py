@@ -17,7 +17,7 @@ over three references at a REMUS speed and turn radius both truths can fly (1.25
 30 m radius or wider: a helix, a lawnmower survey with 60 m line spacing, a waypoint spline), each with and without an ocean current
 (Gauss-Markov, mean (0.2, 0.1, 0) m/s NED, sigma 0.05 m/s, tau 60 s).  No disturbance force:
 the model gap is the disturbance.  The vehicle starts 0.5 m beside the reference's start at the
-reference speed, its propeller trimmed (:func:`auvtrack.plant.truth6.trim_rpm`).
+reference speed, its propeller trimmed (:func:`auvtrack.plant.sixdof.truth.trim_rpm`).
 
 Reported per run: status and failure cause (pitch, roll, envelope, divergence, ...), steady-state
 tracking error (RMSE and max |e| over the second half), and actuator usage: the time each

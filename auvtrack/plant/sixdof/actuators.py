@@ -9,7 +9,7 @@ with a magnitude limit ``a_max`` and an optional rate limit ``rate_max``::
 This is the continuous-time form of the PVS update (Fossen's ``remus100.dynamics``: the actual
 value is clipped, then integrated towards the unclipped command with time constant T), so a
 command beyond the limit holds the actuator at the limit.  The allocation reports such commands
-as saturated (:mod:`auvtrack.plant.prestero`, :mod:`auvtrack.plant.fossen_remus`).
+as saturated (:mod:`auvtrack.plant.sixdof.prestero`, :mod:`auvtrack.plant.sixdof.fossen`).
 
 References
 ----------
@@ -18,8 +18,8 @@ Section 8.4.2 (REMUS 100 actuator time constants and limits); ch. 11 (magnitude 
 """
 from __future__ import annotations
 
-from .._jit import njit_noalloc
-from .layout6 import (IX_DR, IX_DS, IX_N, P_DMAX, P_DRATE, P_NMAX, P_NRATE, P_TDELTA, P_TN)
+from ..._jit import njit_noalloc
+from .layout import (IX_DR, IX_DS, IX_N, P_DMAX, P_DRATE, P_NMAX, P_NRATE, P_TDELTA, P_TN)
 
 
 @njit_noalloc(inline="always")

@@ -1,7 +1,7 @@
 """The 6-DOF truth models by preset: packing the parameters, and a Python-side reference integrator.
 
-``MODELS`` maps a preset name to its model module (:mod:`auvtrack.plant.prestero`,
-:mod:`auvtrack.plant.fossen_remus`); each provides ``pack(preset, common)``, the compiled
+``MODELS`` maps a preset name to its model module (:mod:`auvtrack.plant.sixdof.prestero`,
+:mod:`auvtrack.plant.sixdof.fossen`); each provides ``pack(preset, common)``, the compiled
 ``derivative(x, att, vc, dist, cmd, pp, dx)``, ``produced`` and ``allocate_tau``.
 :func:`pack_truth` builds the packed parameters with the actuator block filled from the preset
 (optionally overridden, e.g. by ``plant.delta_rate_max``).
@@ -13,13 +13,13 @@ from types import ModuleType
 
 import numpy as np
 
-from . import fossen_remus, prestero
-from .kinematics import attitude
-from .layout6 import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_MINV, P_NMAX, P_NRATE,
+from . import fossen, prestero
+from ..kinematics import attitude
+from .layout import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_MINV, P_NMAX, P_NRATE,
                       P_TDELTA, P_TN, PP6_SIZE)
-from .presets6 import Preset6, load_preset6
+from .presets import Preset6, load_preset6
 
-MODELS: dict[str, ModuleType] = {"remus100_prestero": prestero, "remus100_fossen": fossen_remus}
+MODELS: dict[str, ModuleType] = {"remus100_prestero": prestero, "remus100_fossen": fossen}
 
 ACTUATOR_KEYS = ("delta_max", "n_max", "T_delta", "T_n", "delta_rate_max", "n_rate_max")
 _SLOTS = dict(zip(ACTUATOR_KEYS, (P_DMAX, P_NMAX, P_TDELTA, P_TN, P_DRATE, P_NRATE)))
@@ -64,7 +64,7 @@ def pack_truth(name: str, overrides: dict | None = None, direct: bool = False) -
     Returns
     -------
     numpy.ndarray
-        Length :data:`auvtrack.plant.layout6.PP6_SIZE`.
+        Length :data:`auvtrack.plant.sixdof.layout.PP6_SIZE`.
     """
     pr = load_preset6(name)
     common = np.zeros(PP6_SIZE)

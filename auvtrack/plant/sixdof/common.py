@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import math
 
-from .._jit import njit_noalloc
-from ..environment.current import current_velocity
-from ..environment.disturbances import add_paper, add_pulse
-from ..environment.layout import KIND_CURRENT, KIND_PAPER, KIND_PULSE
-from .actuators6 import effective
-from .contract import CAUSE_PITCH, CAUSE_ROLL, SF_PHI_LIM, SF_THETA_LIM
-from .layout6 import CMD_DR, CMD_DS, CMD_N, CMD_TAU, P_DIRECT, P_DMAX, P_NMAX
+from ..._jit import njit_noalloc
+from ...environment.current import current_velocity
+from ...environment.disturbances import add_paper, add_pulse
+from ...environment.layout import KIND_CURRENT, KIND_PAPER, KIND_PULSE
+from .actuators import effective
+from ..contract import CAUSE_PITCH, CAUSE_ROLL, SF_PHI_LIM, SF_THETA_LIM
+from .layout import CMD_DR, CMD_DS, CMD_N, CMD_TAU, P_DIRECT, P_DMAX, P_NMAX
 
 SCR_DIST, SCR_VC = 0, 5  # scratch: disturbance forces (5), current velocity (3)
 

@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .layout6 import LOG_NAMES6
-from .presets6 import load_preset6
-from .truth6 import MODELS, initial_state, pack_truth, trim_rpm
+from .layout import LOG_NAMES6
+from .presets import load_preset6
+from .truth import MODELS, initial_state, pack_truth, trim_rpm
 
 
 @dataclass(frozen=True)
@@ -22,7 +22,7 @@ class Truth6:
     Attributes
     ----------
     pp : numpy.ndarray
-        Packed parameters (:mod:`auvtrack.plant.layout6`).
+        Packed parameters (:mod:`auvtrack.plant.sixdof.layout`).
     x0 : numpy.ndarray
         Initial state (15,).
     log_names : tuple of str

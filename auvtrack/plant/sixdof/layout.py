@@ -17,7 +17,7 @@ allocation, then the controller's commanded [tau_u, tau_q, tau_r] (logged next t
 tau).
 
 Packed parameters ``pp`` (float64): the common block below, then the model's own block from
-:data:`P_MODEL` (layouts in :mod:`auvtrack.plant.prestero` and :mod:`auvtrack.plant.fossen_remus`).
+:data:`P_MODEL` (layouts in :mod:`auvtrack.plant.sixdof.prestero` and :mod:`auvtrack.plant.sixdof.fossen`).
 Matrices are 6x6 row-major.
 """
 from __future__ import annotations

@@ -45,12 +45,12 @@ import math
 
 import numpy as np
 
-from .._jit import njit_noalloc
-from .actuators6 import actuator_rates, clip, effective, fin_angle_for
-from .layout6 import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL, P_MRB, P_NMAX, P_RB,
+from ..._jit import njit_noalloc
+from .actuators import actuator_rates, clip, effective, fin_angle_for
+from .layout import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL, P_MRB, P_NMAX, P_RB,
                       P_RG, P_W, PP6_SIZE)
-from .presets6 import Preset6
-from .rigid6 import (check_spd, euler_rates, inertia_about_origin, kirchhoff, matvec6, ned_velocity,
+from .presets import Preset6
+from .rigid import (check_spd, euler_rates, inertia_about_origin, kirchhoff, matvec6, ned_velocity,
                      restoring, rigid_body_mass, trig_att)
 
 (FZ_RHO, FZ_S, FZ_CD0, FZ_CLA, FZ_KIND, FZ_CCF, FZ_L, FZ_NSTRIP,
@@ -246,7 +246,7 @@ def cross_flow(vr, r, pp):
 
 @njit_noalloc
 def derivative(x, att, vc, dist, cmd, pp, dx):
-    """dx[0:15] = f(x, cmd) of the module docstring (arguments as :func:`auvtrack.plant.prestero.derivative`)."""
+    """dx[0:15] = f(x, cmd) of the module docstring (arguments as :func:`auvtrack.plant.sixdof.prestero.derivative`)."""
     tr = trig_att(x[3], att)
     u, v, w, p, q, r = x[6], x[7], x[8], x[9], x[10], x[11]
     cps, sps = tr[4], tr[5]

@@ -1,18 +1,18 @@
-"""Plant module ``remus100_prestero``: the 6-DOF truth model of :mod:`auvtrack.plant.prestero` behind the plant contract.
+"""Plant module ``remus100_prestero``: the 6-DOF truth model of :mod:`auvtrack.plant.sixdof.prestero` behind the plant contract.
 
 Contract (docs/architecture.md): ``pose``, ``accel5``, ``allocate``, ``rhs``, ``applied``,
 ``attitude_cause``, ``log_extra`` (compiled, allocation-free).  State layout, command and logged
-channels: :mod:`auvtrack.plant.layout6`.  The controller commands tau = [tau_u, tau_q, tau_r];
+channels: :mod:`auvtrack.plant.sixdof.layout`.  The controller commands tau = [tau_u, tau_q, tau_r];
 ``allocate`` maps it to rudder, stern-plane and propeller commands by inverting the actuator
 model at the measured speed (or passes actuator commands through for ``open_loop_actuators``).
 """
 from __future__ import annotations
 
-from .._jit import njit_noalloc
+from ..._jit import njit_noalloc
 from . import prestero
-from .actuators6 import effective
-from .layout6 import CMD_TAU, LOG_NAMES6, N_CMD6, NX6, P_DIRECT
-from .sixdof_common import accel5, attitude_cause6, direct_command, environment, log_extra, pose
+from .actuators import effective
+from .layout import CMD_TAU, LOG_NAMES6, N_CMD6, NX6, P_DIRECT
+from .common import accel5, attitude_cause6, direct_command, environment, log_extra, pose
 
 NAME = "remus100_prestero"
 NX = NX6

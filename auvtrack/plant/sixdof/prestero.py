@@ -7,7 +7,7 @@ Model (P01 eq. 3.x with the coefficient tables of ch. 4; Fossen 2021 eq. 10.1 fo
 
 * ``M_RB`` about the centre of buoyancy with the CG offset r_g (P01's rigid-body equations);
   ``M_A = -[X_udot ... ; Y_rdot, Z_qdot off-diagonal]``; both SPD (checked at packing).
-* ``C_RB(nu) nu``, ``C_A(nu_r) nu_r``: Kirchhoff form (:func:`auvtrack.plant.rigid6.kirchhoff`);
+* ``C_RB(nu) nu``, ``C_A(nu_r) nu_r``: Kirchhoff form (:func:`auvtrack.plant.sixdof.rigid.kirchhoff`);
   the second is P01's set of added-mass cross terms (X_wq, X_vr, Y_wp, Z_vp, M_uwa, N_uva, ...),
   derived from M_A instead of typed (a test checks them against P01's printed values).
 * ``tau_h``: axial drag X_u|u| u|u|; cross-flow drag Y_v|v| v|v|, Y_r|r| r|r|, Z_w|w| w|w|,
@@ -38,12 +38,12 @@ import math
 
 import numpy as np
 
-from .._jit import njit_noalloc
-from .actuators6 import actuator_rates, clip, effective, fin_angle_for
-from .layout6 import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL, P_MRB, P_NMAX, P_RB,
+from ..._jit import njit_noalloc
+from .actuators import actuator_rates, clip, effective, fin_angle_for
+from .layout import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL, P_MRB, P_NMAX, P_RB,
                       P_RG, P_W, PP6_SIZE)
-from .presets6 import Preset6
-from .rigid6 import (body_from_ned6, check_spd, euler_rates, kirchhoff, matvec6, ned_velocity,
+from .presets import Preset6
+from .rigid import (body_from_ned6, check_spd, euler_rates, kirchhoff, matvec6, ned_velocity,
                      restoring, rigid_body_mass, trig_att)
 
 # model block: quadratic drag (10), lift (8), fins (4), propeller (3)
@@ -194,7 +194,7 @@ def derivative(x, att, vc, dist, cmd, pp, dx):
     Parameters
     ----------
     x : ndarray (15,)
-        State (layout :mod:`auvtrack.plant.layout6`).
+        State (layout :mod:`auvtrack.plant.sixdof.layout`).
     att : tuple of 4 float
         (cos theta, sin theta, cos psi, sin psi) of x (the engine computes them once per stage).
     vc : tuple of 3 float

@@ -5,8 +5,8 @@ Files live in ``auvtrack/data/vehicles/6dof/<name>.toml``: sections of entries
 :func:`load_preset6` returns the values by ``"section.key"`` together with the full record, which
 goes into ``run.json`` so every number of a run can be traced to its source.  Shipped:
 
-* ``remus100_prestero`` -- Prestero (2001), :mod:`auvtrack.plant.prestero`;
-* ``remus100_fossen`` -- Fossen (2021) / PVS ``remus100.py``, :mod:`auvtrack.plant.fossen_remus`.
+* ``remus100_prestero`` -- Prestero (2001), :mod:`auvtrack.plant.sixdof.prestero`;
+* ``remus100_fossen`` -- Fossen (2021) / PVS ``remus100.py``, :mod:`auvtrack.plant.sixdof.fossen`.
 """
 from __future__ import annotations
 
