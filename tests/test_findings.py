@@ -14,7 +14,7 @@ from dataclasses import asdict
 
 import pytest
 
-from auvtrack.studies import ablation, findings, fixed_time, robustness
+from auvtrack.studies import ablation, findings, fixed_time, model_gap, robustness
 
 ALLOWED = [
     r"REMUS 100", r"ERRATA \d+", r"issue \d+", r"§\d+", r"Section \d+", r"Sec\. \d+(\.\d+)?",
@@ -98,6 +98,11 @@ def test_stored_results_come_from_the_current_study_definitions():
     assert rp["conditions"] == cond
     assert [f["name"] for f in rp["forms"]] == [f[0] for f in FORMS]
     assert rp["steady_window"]["window"] == [50.0, 100.0]  # the full run, not --quick
+    mg = findings.load("model-gap")
+    assert mg["quick"] is False and mg["duration_s"] == 150.0
+    assert sorted((r["controller"], r["truth"], r["reference"], r["current"]) for r in mg["rows"]) == \
+        sorted(model_gap.jobs(False))
+    assert mg["references"] == _jsonish(model_gap.REFERENCES) and mg["current"] == _jsonish(model_gap.CURRENT)
     for name in findings.SOURCES:
         assert findings.load(name)["_provenance"]["command"] == findings.SOURCES[name]
 
@@ -152,3 +157,53 @@ def test_the_prose_of_findings_md_holds_on_the_stored_results():
             a = next(r for r in mine if r["factor"] == "current" and r["level"] == lv and r["controller"] == "fxtntsmc")
             b = next(r for r in mine if r["factor"] == "current" and r["level"] == lv and r["controller"] == "ftsmc")
             assert a["status"] == "ok" and (b["status"] != "ok" or a["rmse"] < b["rmse"])
+
+
+def test_the_model_gap_and_remus_prose_holds_on_the_stored_results():
+    """§6 and §7 of findings.md: each sentence outside the generated blocks, read on the data."""
+    mg = findings.load("model-gap")
+    rows = mg["rows"]
+
+    def mine(kind, truths=("prestero", "fossen"), current=None):
+        return [r for r in rows if r["controller"] == kind and r["truth"] in truths
+                and (current is None or r["current"] is current)]
+
+    own = mine("fxtntsmc", ("5dof",))
+    assert all(r["status"] == "ok" for r in own) and max(r["rmse_late"] for r in own) < 1e-3
+    for r in mine("fxtntsmc"):  # fails every truth run, by divergence or envelope violation, early
+        assert r["status"] != "ok" and r["fail_time"] < 15.0
+        assert r["cause"] in ("state_limit", "nonfinite", "envelope_violation")
+    assert all(r["status"] == "ok" for r in mine("ftsmc", ("5dof", "prestero", "fossen")))
+    assert max(r["rmse_late"] for r in mine("ftsmc", ("5dof",), False)) < 1e-7  # nanometres on its model
+    assert min(r["rmse_late"] for r in mine("ftsmc")) > 0.1  # decimetres or metres on the truths
+    assert max(r["t_sat_tau_u"] for r in mine("ftsmc", ("prestero",))) > 10.0  # propeller, long stretches
+    assert max(r["t_sat_tau_r"] for r in mine("ftsmc", ("fossen",), True)) > 10.0  # rudder with current
+    calm_f = [r["rmse_late"] for r in mine("ftsmc", ("fossen",), False)]
+    calm_p = [r["rmse_late"] for r in mine("ftsmc", ("prestero",), False)]
+    assert min(calm_f) > 2 * max(calm_p)  # the truths disagree with each other
+    half = mg["duration_s"] / 2
+    for kind in ("pid", "backstepping", "sta"):
+        runs = mine(kind)
+        assert all(r["status"] == "ok" for r in runs)
+        assert sum(r["rmse_late"] > 1.0 for r in runs) > len(runs) / 2  # mostly do not track
+        assert sum(max(r[f"t_sat_tau_{j}"] for j in "uqr") > half / 2 for r in runs) > len(runs) / 2
+    assert all(r["status"] != "ok" and r["cause"] == "envelope_violation" for r in mine("ppc"))
+    ppc_own = mine("ppc", ("5dof",))
+    assert 2 * sum(r["status"] != "ok" for r in ppc_own) == len(ppc_own)  # half of its design-model runs
+    # §6: the reduction's damping at the operating speed is smaller than at the trial speed
+    from auvtrack.plant.presets import get_preset
+    from auvtrack.plant.reduction import reduce_prestero
+    from auvtrack.scenario import load_scenario, paper_scenario_path
+
+    u0 = load_scenario(paper_scenario_path(), ["vehicle.preset=remus100"]).vehicle.u0
+    trial = get_preset("remus100").u0
+    assert u0 < trial and all(a < b for a, b in zip(reduce_prestero(u0)["d"], reduce_prestero(trial)["d"]))
+    per = findings.load("robustness")["summary"]["remus100"]
+    assert per and all(s["failed"] >= 1 for s in per.values())  # every controller fails some run on it
+
+
+def test_findings_md_does_not_link_the_merged_draft():
+    """The issue-11 draft was merged into findings.md §6 and §7 and deleted; no document links it."""
+    assert not (findings.ROOT / "docs" / "findings_model_gap.md").exists()
+    for path in [findings.ROOT / "README.md", *sorted((findings.ROOT / "docs").glob("*.md"))]:
+        assert "findings_model_gap" not in path.read_text(), path.name

@@ -7,6 +7,8 @@ output of the command that owns it (:data:`SOURCES`); nothing is typed by hand. 
     python -m auvtrack.studies.findings store reproduce reproduce/metrics.json
     auvtrack study ablation --out studies/ablation
     python -m auvtrack.studies.findings store ablation studies/ablation/results.json
+    auvtrack study model-gap --out studies/model-gap
+    python -m auvtrack.studies.findings store model-gap studies/model-gap/results.json
     ...                                      # one pair per entry of SOURCES
     python -m auvtrack.studies.findings render   # rewrite the generated blocks
 
@@ -41,6 +43,7 @@ SOURCES: dict[str, str] = {
     "fixed-time": "auvtrack study fixed-time --out studies/fixed-time  (results.json)",
     "robustness": "auvtrack study robustness --out studies/robustness  (results.json)",
     "realism": "auvtrack study realism --out studies/realism  (results.json)",
+    "model-gap": "auvtrack study model-gap --out studies/model-gap  (results.json)",
 }
 """Stored result name -> the command whose output it is."""
 
@@ -316,6 +319,99 @@ def _realism_cell(r: dict | None) -> str:
     return f"ok, RMSE {_f(r['rmse'], 2)} m, TV {_f(r['tv_tau'], 2)}"
 
 
+def _span(xs: list[float], d: int = 2) -> str:
+    """``a–b`` (or ``a`` when equal, ``–`` when empty) of the finite values ``xs``."""
+    xs = [x for x in xs if x is not None and math.isfinite(x)]
+    if not xs:
+        return "–"
+    lo, hi = min(xs), max(xs)
+    return _f(lo, d) if _f(lo, d) == _f(hi, d) else f"{_f(lo, d)}–{_f(hi, d)}"
+
+
+def _ref_speed(spec: dict) -> float:
+    return float(spec["speed"]) if "speed" in spec else float(spec["omega"]) * float(spec["radius"])
+
+
+def model_gap_tally(mg: dict) -> dict[str, dict[str, list[int]]]:
+    """Controller -> truth -> [failed, runs] of the model-gap study."""
+    out: dict[str, dict[str, list[int]]] = {}
+    for r in mg["rows"]:
+        c = out.setdefault(r["controller"], {}).setdefault(r["truth"], [0, 0])
+        c[0] += r["status"] != "ok"
+        c[1] += 1
+    return out
+
+
+def block_model_gap(mg: dict) -> str:
+    """Findings section 7: controllers designed on the 5-DOF REMUS 100 flown on 6-DOF truths."""
+    rows, cur = mg["rows"], mg["current"]
+    refs = ", ".join(f"{k} ({_f(_ref_speed(v))} m/s)" for k, v in mg["references"].items())
+    currents = sorted({r["current"] for r in rows})
+    lines = [
+        f"{_f(mg['duration_s'])} s runs" + (" (`--quick`: the helix, calm, only)" if mg["quick"] else "")
+        + f"; references {refs}, " + ("calm and with " if currents == [False, True] else "calm" if currents == [False]
+                                      else "with ")
+        + (f"a Gauss–Markov current (mean {cur['mean']} m/s NED, σ {cur['sigma']} m/s, τ {_f(cur['tau'])} s)"
+           if True in currents else "")
+        + "; every built-in tracking controller with its package defaults, designed on the 5-DOF `remus100` preset "
+          "reduced at the reference's speed; truths `5dof` (the design model itself, no uncertainty), `prestero` "
+          "(`remus100_prestero`) and `fossen` (`remus100_fossen`), the two 6-DOF with roll and with fins and propeller "
+          "(lags, limits) behind the control allocation; start beside the path at speed, propeller trimmed; no "
+          "disturbance force.  Steady RMSE of |e| and the time with τ unproducible over the second half, for the "
+          "runs that completed.", "",
+        "| controller | truth | failed | causes (time of failure, s) | steady RMSE calm (m) | steady RMSE with "
+        "current (m) | τ unproducible u / q / r, max (s) |", "|---|---|---|---|---|---|---|"]
+    tally = model_gap_tally(mg)
+    for kind, per in tally.items():
+        for truth, (nf, n) in per.items():
+            mine = [r for r in rows if r["controller"] == kind and r["truth"] == truth]
+            bad = [r for r in mine if r["status"] != "ok"]
+            causes = "; ".join(f"{c.replace('_', ' ')} × {sum(r['cause'] == c for r in bad)} "
+                               f"({_span([r['fail_time'] for r in bad if r['cause'] == c], 3)})"
+                               for c in sorted({r["cause"] for r in bad})) or "–"
+            ok = [r for r in mine if r["status"] == "ok"]
+            rm = {c: _span([r["rmse_late"] for r in ok if r["current"] is c]) for c in (False, True)}
+            ts = " / ".join(_span([max((r.get(f"t_sat_tau_{j}") or 0.0) for r in ok)]) if ok else "–" for j in INPUTS)
+            lines.append(f"| {kind} | {truth} | {nf} of {n} | {causes} | {rm[False]} | {rm[True]} | {ts} |")
+    own = {k: v["5dof"] for k, v in tally.items() if "5dof" in v}
+    truth = _truth_failures(mg)
+    lines += ["", "On their design model: " + ", ".join(f"{k} {n - f} of {n} completed" for k, (f, n) in own.items())
+              + ".  On the 6-DOF truths: " + ", ".join(f"{k} fails {f} of {n}" for k, (f, n) in truth.items()) + "."]
+    return "\n".join(lines)
+
+
+def block_remus_u0(rb: dict, rl: dict) -> str:
+    """Findings section 6: the REMUS 100 reduction's linearisation speed and the REMUS numbers that use it."""
+    from ..plant.presets import get_preset
+    from ..plant.reduction import reduce_prestero
+    from ..scenario import load_scenario, paper_scenario_path
+
+    u0 = {}
+    for dur in sorted({float(rb["config"]["duration"]), float(rl["duration_s"])}):
+        sc = load_scenario(paper_scenario_path(), ["vehicle.preset=remus100", f"sim.duration={dur:g}"])
+        u0[dur] = sc.vehicle.u0
+    now = next(iter(u0.values()))
+    trial = get_preset("remus100").u0
+    d_now, d_trial = reduce_prestero(now)["d"], reduce_prestero(trial)["d"]
+    ratio = _span([b / a for a, b in zip(d_now, d_trial)])
+    per = rb["summary"].get("remus100", {})
+    fails = {k: sum(1 for r in rl["rows"] if r["vehicle"] == "remus100" and r["controller"] == k
+                    and r["status"] != "ok") for k in ("fxtntsmc", "ftsmc")}
+    n = {k: sum(1 for r in rl["rows"] if r["vehicle"] == "remus100" and r["controller"] == k) for k in fails}
+    return "\n".join([
+        "The 5-DOF `remus100` preset is reduced from `remus100_prestero` (P01's coefficients) at the linearisation "
+        "speed `vehicle.u0`, by default the mean speed of the scenario's reference: U0 = "
+        + ", ".join(f"{_f(u, 3)} m/s" for u in dict.fromkeys(u0.values()))
+        + f" for the Section 4 helix over {', '.join(_f(d) for d in u0)} s; the preset file's speed (P01's trial "
+          f"speed) is {_f(trial)} m/s.  Damping d (surge, sway, heave, pitch, yaw) at U0: "
+        + " / ".join(_f(x, 3) for x in d_now) + f"; at {_f(trial)} m/s: " + " / ".join(_f(x, 3) for x in d_trial)
+        + f" ({ratio} times larger).", "",
+        "Every REMUS 100 number on this page uses U0: in §4 (`auvtrack study robustness`) the failed runs on "
+        "`remus100` are " + ", ".join(f"{lab} {s['failed']} of {s['n']}" for lab, s in per.items())
+        + f"; in §5 (`auvtrack study realism`) the FXTNTSMC fails {fails['fxtntsmc']} of {n['fxtntsmc']} runs on "
+          f"`remus100`, the FTSMC {fails['ftsmc']} of {n['ftsmc']}."])
+
+
 def block_realism(rl: dict) -> str:
     """Findings section 5: one factor at a time, both controllers, per vehicle."""
     from .realism import FACTORS
@@ -384,7 +480,7 @@ def _direction_matters(ab: dict) -> bool:
     return signs == {1, -1}
 
 
-def block_summary(rp: dict, ab: dict, s40: dict, ft: dict, rb: dict, rl: dict) -> str:
+def block_summary(rp: dict, ab: dict, s40: dict, ft: dict, rb: dict, rl: dict, mg: dict | None = None) -> str:
     """Findings summary: one computed statement per study, each with its conditions."""
     v = _verdicts(rp["verdicts"])
     forms = {f["name"]: f for f in rp["forms"]}
@@ -432,6 +528,12 @@ def block_summary(rp: dict, ab: dict, s40: dict, ft: dict, rb: dict, rl: dict) -
     per = rb["summary"].get("paper", {})
     items.append("**Monte Carlo** (`auvtrack study robustness`, paper vehicle): failed runs " + ", ".join(
         f"{lab} {s['failed']} of {s['n']}" for lab, s in per.items()) + ".")
+    if mg is not None:
+        truth = _truth_failures(mg)
+        items.append("**Model gap** (`auvtrack study model-gap`" + (", `--quick`" if mg["quick"] else "")
+                     + ", designed on the 5-DOF `remus100`, flown on the 6-DOF REMUS 100 truths of Prestero and "
+                       "Fossen, package defaults): failed truth runs " + ", ".join(
+                         f"{k} {f} of {n}" for k, (f, n) in truth.items()) + ".")
     return "\n".join(f"{i}. {t}" for i, t in enumerate(items, 1))
 
 
@@ -444,7 +546,13 @@ def block_provenance(names: list[str]) -> str:
     return "\n".join(lines)
 
 
-def block_readme(rp: dict, ab: dict, ft: dict, rl: dict) -> str:
+def _truth_failures(mg: dict) -> dict[str, list[int]]:
+    """Controller -> [failed, runs] over the model-gap study's 6-DOF truths (not the design model)."""
+    return {k: [sum(v[t][0] for t in v if t != "5dof"), sum(v[t][1] for t in v if t != "5dof")]
+            for k, v in model_gap_tally(mg).items()}
+
+
+def block_readme(rp: dict, ab: dict, ft: dict, rl: dict, mg: dict | None = None) -> str:
     """README "What the reproduction shows": verdicts with their conditions, printed forms too."""
     v = _verdicts(rp["verdicts"])
     forms = {f["name"]: f for f in rp["forms"]}
@@ -489,6 +597,11 @@ def block_readme(rp: dict, ab: dict, ft: dict, rl: dict) -> str:
     fx, fts = _realism_failures(rl, "paper", "fxtntsmc"), _realism_failures(rl, "paper", "ftsmc")
     lines.append(f"* **realism** (paper vehicle, one factor at a time): the FXTNTSMC fails at {'; '.join(fx) or 'no level'};"
                  f" the FTSMC at {'; '.join(fts) or 'no level'}.")
+    if mg is not None:
+        lines.append("* **model gap** (designed on the 5-DOF REMUS 100, flown on its 6-DOF truth models"
+                     + (", `--quick`" if mg["quick"] else "") + "): failed truth runs " + ", ".join(
+                         f"{k} {f} of {n}" for k, (f, n) in _truth_failures(mg).items())
+                     + "; completing is not tracking, docs/findings.md §7 has the errors.")
     return "\n".join(lines)
 
 
@@ -497,15 +610,19 @@ def blocks() -> dict[str, tuple[str, Callable[[], str]]]:
     """Generated block name -> (document key, renderer)."""
     return {
         "summary": ("findings", lambda: block_summary(load("reproduce"), load("ablation"), load("ablation-surge40"),
-                                                      load("fixed-time"), load("robustness"), load("realism"))),
+                                                      load("fixed-time"), load("robustness"), load("realism"),
+                                                      load("model-gap"))),
         "reproduce": ("findings", lambda: block_reproduce(load("reproduce"))),
         "fixed-time": ("findings", lambda: block_fixed_time(load("fixed-time"))),
         "ablation": ("findings", lambda: block_ablation(load("ablation"), load("ablation-surge40"))),
         "robustness": ("findings", lambda: block_robustness(load("robustness"))),
         "realism": ("findings", lambda: block_realism(load("realism"))),
+        "remus-u0": ("findings", lambda: block_remus_u0(load("robustness"), load("realism"))),
+        "model-gap": ("findings", lambda: block_model_gap(load("model-gap"))),
         "provenance": ("findings", lambda: block_provenance(list(SOURCES))),
         "readme-reproduction": ("readme", lambda: block_readme(load("reproduce"), load("ablation"),
-                                                               load("fixed-time"), load("realism"))),
+                                                               load("fixed-time"), load("realism"),
+                                                               load("model-gap"))),
     }
 
 
