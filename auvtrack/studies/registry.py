@@ -33,11 +33,15 @@ class StudySpec:
         ``run(out, *, quick=False, progress=False) -> Path`` (see :class:`StudyRunner`).
     summary : str
         One line shown by ``auvtrack study --help``.
+    options : tuple of str
+        Keyword options of ``run`` beyond ``quick`` and ``progress`` that the command line may
+        pass (e.g. ``("pulse", "pulse_start")`` for ``--pulse``, ``--pulse-start``).
     """
 
     name: str
     run: Callable[..., Path]
     summary: str = ""
+    options: tuple[str, ...] = ()
 
 
 def all_studies() -> dict[str, StudySpec]:
