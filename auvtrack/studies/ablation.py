@@ -44,9 +44,9 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..scenario import load_scenario, paper_scenario_path
-from ..simulation.api import prepare, run_prepared
+from ..simulation.api import compile_first, prepare, run_prepared
 from ..simulation.result import Result
-from .registry import StudySpec
+from .registry import StudySpec, kinds_in
 from .report import Report, failure_cause, fmt, write_json
 
 ENVELOPE_KINDS = ("none", "rigid", "reactive", "proactive")
@@ -657,6 +657,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     st = settings or settings_for(quick, pulse, pulse_start)
     out = Path(out)
     cfgs = [c for c in configurations() if not st.configs or c.label in st.configs]
+    compile_first([(k, "5dof") for k in kinds_in(o for c in cfgs for o in c.overrides)], progress=progress)
     nominal = _pool_map(_nominal_job, [(c, cond, st) for cond in st.conditions for c in cfgs], progress, "nominal")
     jobs = [(c, cond, d, vec, st) for d, vec in st.directions for cond in st.conditions for c in cfgs]
     scans = _pool_map(_scan_job, jobs, progress, "survival scan")

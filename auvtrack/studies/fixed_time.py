@@ -31,9 +31,9 @@ from ..control.theory import fixed_time_bounds
 from ..plant.kinematics import attitude, j3_inv, virtual_point
 from ..reference import build_reference
 from ..scenario import Scenario, load_scenario
-from ..simulation.api import prepare, run_prepared, vehicle_arrays
+from ..simulation.api import compile_first, prepare, run_prepared, vehicle_arrays
 from ..scenario import paper_scenario_path
-from .registry import StudySpec
+from .registry import StudySpec, kinds_in
 from .report import Report, failure_cause, fmt, write_json
 
 VARIANTS: dict[str, tuple[str, ...]] = {
@@ -393,6 +393,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     out = Path(out)
     jobs = [(s0, k, d, float(m), st) for s0 in st.starts for k in st.controllers for d in st.directions
             for m in st.magnitudes]
+    compile_first([(k, "5dof") for k in kinds_in(o for v in st.controllers for o in VARIANTS[v])], progress=progress)
     with ThreadPoolExecutor(max_workers=2) as pool:  # the compiled kernel releases the GIL
         rows = list(tqdm(pool.map(_run_one, jobs), total=len(jobs), disable=not progress, desc="fixed-time"))
     sc = load_scenario(paper_scenario_path(), [f"sim.duration={st.duration:g}"])

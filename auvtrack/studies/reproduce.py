@@ -26,7 +26,7 @@ from tqdm.auto import tqdm
 from ..control.fxtntsmc import StartOutsideEnvelope
 from ..control.params import get_gain_preset
 from ..simulation import plotting
-from ..simulation.api import prepare, run_prepared
+from ..simulation.api import compile_first, prepare, run_prepared
 from ..simulation.result import Result
 from ..scenario import load_scenario
 from ..scenario import paper_scenario_path
@@ -273,6 +273,7 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     out.mkdir(parents=True, exist_ok=True)
     overrides = ["sim.duration=20"] if quick else []
     window = (10.0, 20.0) if quick else (50.0, 100.0)  # steady state: accuracy and chattering claims
+    compile_first([(kind, "5dof") for _, kind in CONTROLLERS], progress=progress)
     bar = tqdm(total=2 * len(CONTROLLERS) + len(FIGURES), disable=not progress, desc="reproduce", unit="step")
     runs, full, steady, steady_runs = {}, {}, {}, {}
     tuned, tuned_full, tuned_steady = {}, {}, {}
