@@ -5,6 +5,7 @@ import math
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -16,6 +17,7 @@ from auvtrack import _jit, _vecmath
 from auvtrack._vecmath import atanh4, exp8, pow4, sincos4
 from auvtrack.control import fxtntsmc, rbf
 
+ROOT = Path(__file__).resolve().parents[1]
 MAX_ULP = 4  # glibc's bound for libmvec (manual, "Errors in Math Functions")
 
 
@@ -174,8 +176,10 @@ def test_rbf_basis_matches_eq12_for_any_neuron_count(m):
 
 def _law_points(tmp_path, backend_env: str, given=None) -> dict:
     out = tmp_path / f"law-{backend_env}.npz"
-    subprocess.run([sys.executable, "tests/law_points.py", str(out)] + ([str(given)] if given else []),
-                   check=True, env={**os.environ, "AUVTRACK_LIBMVEC": backend_env})
+    subprocess.run([sys.executable, str(ROOT / "tests" / "law_points.py"), str(out)] + ([str(given)] if given else []),
+                   check=True, env={**os.environ, "AUVTRACK_LIBMVEC": backend_env,
+                                    "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))},
+                   cwd=ROOT)
     return dict(np.load(out))
 
 
