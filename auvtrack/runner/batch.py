@@ -36,7 +36,7 @@ from ..simulation.engine import Outputs
 from ..simulation.metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from ..simulation.result import Result
 
-BACKENDS = ("threads", "prange", "serial")
+BACKENDS = ("threads", "prange", "serial", "simd")
 
 __all__ = ["RunSummary", "run_metrics", "run_batch", "iter_batch", "BACKENDS", "default_workers", "StopSignal",
            "BatchInterrupted"]
@@ -200,6 +200,81 @@ def _run_prange(preps: Sequence[Prepared], stop: StopSignal) -> list[RunSummary]
     return out  # type: ignore[return-value]
 
 
+def _lane_stack(arrays: list[np.ndarray], lanes: int) -> np.ndarray:
+    """Stack n equal-shape arrays into blocks of ``lanes`` runs along a last axis: (blocks, *shape, lanes).
+
+    The last block is padded with copies of its first run (padding lanes are computed, never read).
+    """
+    a = np.stack(arrays)
+    n = a.shape[0]
+    nb = -(-n // lanes)
+    if nb * lanes > n:
+        a = np.concatenate([a, np.repeat(a[(nb - 1) * lanes:(nb - 1) * lanes + 1], nb * lanes - n, axis=0)])
+    a = a.reshape((nb, lanes) + a.shape[1:])
+    return np.ascontiguousarray(np.moveaxis(a, 1, -1))
+
+
+def _run_simd(preps: Sequence[Prepared], stop: StopSignal, workers: int) -> list[RunSummary]:
+    """Runs grouped by kernel and array shapes, each group in blocks of LANES runs (one per SIMD lane).
+
+    Within a group, runs are sorted by length so that a block's lanes end together; blocks are
+    spread over ``workers`` threads (the lane kernel releases the GIL).  A group whose kernel has
+    no lane form (:class:`~auvtrack.simulation.lanes.NotLaneable`) runs on the thread back end.
+    """
+    from ..simulation.lanes import NotLaneable
+
+    L = engine.LANES
+    groups: dict[tuple, list[int]] = {}
+    for i, p in enumerate(preps):
+        groups.setdefault(_shape_key(p), []).append(i)
+    out: list[RunSummary | None] = [None] * len(preps)
+    for idx in groups.values():
+        idx = sorted(idx, key=lambda i: preps[i].n_steps)
+        ps = [preps[i] for i in idx]
+        try:
+            module = kernels.lanes_module(ps[0].key)
+        except NotLaneable:
+            with ThreadPoolExecutor(max_workers=workers) as pool:
+                for i, r in zip(idx, pool.map(lambda p: run_metrics(p, stop), ps)):
+                    out[i] = r
+            continue
+        n = len(ps)
+        nb = -(-n // L)
+        accs0 = []
+        for _ in range(n):
+            a = np.empty(METRICS_SIZE)
+            metrics_init(a)
+            accs0.append(a)
+        accs = _lane_stack(accs0, L)
+        fails = np.zeros((nb, 2, ps[0].n_state, L))
+        infos = np.zeros((nb, engine.INFO_SIZE, L), dtype=np.int64)
+        stop.register(np.moveaxis(infos, 1, -1))  # a view: the stop flag reaches every lane
+        counts = np.array([min(L, n - b * L) for b in range(nb)], dtype=np.int64)
+        causes = np.zeros((nb, L), dtype=np.int64)
+        t_stops = np.zeros((nb, L))
+        logs = np.zeros((nb, 0, len(ps[0].channels), L))
+        args = (_lane_stack([p.plant.pp for p in ps], L), _lane_stack([p.plant.x0 for p in ps], L),
+                _lane_stack([p.cp for p in ps], L), _lane_stack([p.controller.x0 for p in ps], L),
+                _lane_stack([p.vp_nom for p in ps], L), _lane_stack([p.environment.rows for p in ps], L),
+                _lane_stack([p.environment.current for p in ps], L),
+                _lane_stack([p.environment.noise for p in ps], L), _lane_stack([p.ref_p for p in ps], L),
+                _lane_stack([p.si for p in ps], L), _lane_stack([p.sf for p in ps], L), logs, accs, fails, infos,
+                counts, causes, t_stops)
+        nw = max(1, min(workers, nb))
+        cuts = [round(j * nb / nw) for j in range(nw + 1)]
+        if nw == 1:
+            module.run_lanes(*args, 0, nb)
+        else:
+            with ThreadPoolExecutor(max_workers=nw) as pool:
+                list(pool.map(lambda j: module.run_lanes(*args, cuts[j], cuts[j + 1]), range(nw)))
+        for k, i in enumerate(idx):
+            b, l = divmod(k, L)
+            o = Outputs(np.empty((0, len(ps[0].channels))), np.ascontiguousarray(accs[b, :, l]),
+                        np.ascontiguousarray(fails[b, :, :, l]), np.ascontiguousarray(infos[b, :, l]))
+            out[i] = _summary(preps[i], int(causes[b, l]), float(t_stops[b, l]), o)
+    return out  # type: ignore[return-value]
+
+
 def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers: int | None = None,
               backend: str = "threads") -> list[RunSummary] | list[Result]:
     """Run many prepared scenarios, in parallel, and return their outcomes in order.
@@ -243,6 +318,8 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     fn: Callable[[Prepared, StopSignal], Any] = _trajectory if trajectories else run_metrics
     if backend == "prange" and not trajectories:
         return _guarded(lambda: _run_prange(preps, stop), stop)
+    if backend == "simd" and not trajectories:
+        return _guarded(lambda: _run_simd(preps, stop, workers), stop)
     if backend == "serial" or workers == 1 or len(preps) == 1:
         workers = 1
     pool = ThreadPoolExecutor(max_workers=min(workers, len(preps)))
