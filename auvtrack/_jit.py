@@ -44,6 +44,7 @@ def cache_dir() -> Path:
 
 
 numba.config.CACHE_DIR = str(cache_dir())
+LLVM_INLINE = os.environ.get("AUVTRACK_LLVM_INLINE", "1") != "0"
 
 
 class PlainArgsDispatcher(CPUDispatcher):
@@ -85,6 +86,9 @@ def njit(*args, **kwargs):
     """
     kwargs.setdefault("cache", True)
     kwargs.setdefault("error_model", "numpy")
+    if kwargs.get("inline") == "always" and LLVM_INLINE:
+        kwargs.pop("inline")
+        kwargs["forceinline"] = True
     out = numba.njit(*args, **kwargs)
     if args and callable(args[0]):
         return _plain(out)
