@@ -371,8 +371,10 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
            notice: Callable[[str], None] | None = None, progress: bool = False) -> list[KernelKey]:
     """Compile the kernels of ``keys`` that are not cached yet, several at once, and load them.
 
-    One missing kernel compiles in this process; several compile in child processes, ``jobs`` at
-    a time (Numba holds the GIL while compiling), and are then loaded from the disk cache.
+    One missing kernel compiles in this process; several compile in ``jobs`` child processes (Numba
+    holds the GIL while compiling), each compiling its share one after the other, and are then
+    loaded from the disk cache.  The kernels of one law go to the same child, so that the law and
+    the functions the kernels share (plant, reference, metrics) compile once per child.
 
     Parameters
     ----------
@@ -409,9 +411,10 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
                 _compile_in_process(k)
                 bar.update(1)
         else:
-            with ThreadPoolExecutor(max_workers=jobs) as pool:
-                for _ in pool.map(_compile_in_child, todo):
-                    bar.update(1)
+            shares = _shares(todo, jobs)
+            with ThreadPoolExecutor(max_workers=len(shares)) as pool:
+                for f in [pool.submit(_compile_in_child, share, bar) for share in shares]:
+                    f.result()
             for k in todo:  # load the cached machine code into this process
                 kernel(k)
     finally:
@@ -419,17 +422,41 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
     return todo
 
 
-def _compile_in_child(key: KernelKey) -> None:
+def _shares(keys: list[KernelKey], jobs: int) -> list[list[KernelKey]]:
+    """Split ``keys`` over at most ``jobs`` children, the kernels of one law together, sizes balanced."""
+    by_law: dict[str, list[KernelKey]] = {}
+    for k in keys:
+        by_law.setdefault(k.law, []).append(k)
+    shares: list[list[KernelKey]] = [[] for _ in range(min(jobs, len(keys)))]
+    for group in sorted(by_law.values(), key=len, reverse=True):
+        if len(group) > -(-len(keys) // len(shares)):  # a law with more plants than a share: split it
+            for k in group:
+                min(shares, key=len).append(k)
+        else:
+            min(shares, key=len).extend(group)
+    return [s for s in shares if s]
+
+
+def _compile_in_child(keys: list[KernelKey], bar) -> None:
     code = ("import sys, json; from auvtrack.simulation.kernels import KernelKey, _child_compile; "
-            "_child_compile(KernelKey(**json.loads(sys.argv[1])))")
-    arg = json.dumps({"law": key.law, "plant": key.plant, "label": key.label})
-    proc = subprocess.run([sys.executable, "-c", code, arg], capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise RuntimeError(f"compiling {key.label or key.name} failed:\n{proc.stderr.strip()}")
+            "_child_compile([KernelKey(**k) for k in json.loads(sys.argv[1])])")
+    arg = json.dumps([{"law": k.law, "plant": k.plant, "label": k.label} for k in keys])
+    with tempfile.TemporaryFile("w+") as errf, subprocess.Popen(
+            [sys.executable, "-c", code, arg], stdout=subprocess.PIPE, stderr=errf, text=True) as proc:
+        for _ in proc.stdout:  # one line per kernel compiled
+            bar.update(1)
+        rc = proc.wait()
+        errf.seek(0)
+        err = errf.read()
+    if rc != 0:
+        names = ", ".join(k.label or k.name for k in keys)
+        raise RuntimeError(f"compiling {names} failed:\n{err.strip()}")
 
 
-def _child_compile(key: KernelKey) -> None:
-    _compile_in_process(key)
+def _child_compile(keys: list[KernelKey]) -> None:
+    for key in keys:
+        _compile_in_process(key)
+        print(key.name, flush=True)
 
 
 def _cores() -> int:
