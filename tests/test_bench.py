@@ -1,6 +1,7 @@
 """Benchmark plumbing (what is reported, not how fast: speed lives in benchmarks/results.md)."""
 import json
 
+import pytest
 from click.testing import CliRunner
 
 from auvtrack.cli import cli
@@ -52,6 +53,24 @@ def test_batch_rows_cover_every_controller_and_back_end():
 
     rows = bench_batch(repeat=2, runs=3, duration=0.02)
     assert [(r["controller"], r["backend"]) for r in rows] == [
-        (k, b) for k in ("ftsmc", "fxtntsmc") for b in ("serial", "threads", "prange")]
+        (k, b) for k in ("ftsmc", "fxtntsmc") for b in ("serial", "threads", "simd", "prange")]
     for r in rows:
         assert r["runs"] == 3 and r["repeat"] == 2 and 0 < r["runs_per_s"] <= r["max_runs_per_s"]
+
+
+def test_batch_efficiency_is_throughput_relative_to_single_runs():
+    """A core running 10 s runs (10^4 steps) of 1 us per step does 100 runs/s: efficiency 1."""
+    from auvtrack.runner.sweep_bench import batch_efficiency
+
+    row = {"runs_per_s": 200.0, "cores": 2, "run_seconds": 10.0}
+    assert batch_efficiency(row, us_per_step=1.0) == pytest.approx(1.0)
+    assert batch_efficiency({**row, "runs_per_s": 500.0}, us_per_step=1.0) == pytest.approx(2.5)
+
+
+def test_cold_start_compiles_only_the_kernel_it_needs():
+    """The cold run is timed in a new process with an empty cache; it compiles the one kernel of the run."""
+    from auvtrack.runner.sweep_bench import bench_cold_start
+
+    doc = bench_cold_start(duration=0.01)
+    assert doc["kernels_compiled"] == ["k_fxtntsmc__five_dof"]
+    assert 0 < doc["compile_seconds"] < doc["seconds"]

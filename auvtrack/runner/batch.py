@@ -23,6 +23,7 @@ import math
 import os
 import threading
 import time
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Iterator, Sequence
@@ -233,7 +234,9 @@ def _run_simd(preps: Sequence[Prepared], stop: StopSignal, workers: int) -> list
         ps = [preps[i] for i in idx]
         try:
             module = kernels.lanes_module(ps[0].key)
-        except NotLaneable:
+        except NotLaneable as exc:
+            warnings.warn(f"simd back end: {ps[0].key.label or ps[0].key.name} has no lane form ({exc}); "
+                          "its runs use the thread back end", stacklevel=3)
             with ThreadPoolExecutor(max_workers=workers) as pool:
                 for i, r in zip(idx, pool.map(lambda p: run_metrics(p, stop), ps)):
                     out[i] = r

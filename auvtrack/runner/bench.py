@@ -114,15 +114,20 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
 def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = False) -> dict:
     """The full benchmark suite; writes ``results.json`` and ``results.md`` into ``out``.
 
-    Single-run µs per RK4 step for every controller, batch runs/s (10 s runs at dt = 1 ms) per
-    back end, and sweep throughput on 1 and 2 Dask workers (see
-    :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to the source tree's ``benchmarks/``
+    Time to the first result with an empty kernel cache (a cold ``auvtrack run`` and a cold
+    ``auvtrack warmup``, each in a new process), single-run µs per RK4 step for every controller,
+    batch runs/s (10 s runs at dt = 1 ms) and efficiency per back end, and sweep throughput on 1
+    and 2 Dask workers (see :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to the source tree's ``benchmarks/``
     when it exists, else the current folder.
     """
-    from .sweep_bench import bench_batch, bench_breakdown, bench_sweep, write_results
+    from .sweep_bench import (bench_batch, bench_breakdown, bench_cold_start, bench_cold_warmup, bench_sweep,
+                              write_results)
 
     say = print if progress else (lambda *a, **k: None)
     mach = machine()  # load average before our own runs
+    say("cold start")
+    cold = bench_cold_start()
+    cold_warmup = bench_cold_warmup()
     say("single runs")
     single = bench_singles(("open_loop", "ftsmc", "fxtntsmc"), repeat=3 * repeat, duration=20.0)
     say("breakdown")
@@ -131,8 +136,8 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     batch = bench_batch(repeat=repeat)
     say("sweep")
     sweep = bench_sweep(repeat=max(3, repeat // 2))
-    doc = {"machine": mach, "repeat": repeat, "single": single, "breakdown": breakdown, "batch": batch,
-           "sweep": sweep}
+    doc = {"machine": mach, "repeat": repeat, "cold": cold, "cold_warmup": cold_warmup, "single": single,
+           "breakdown": breakdown, "batch": batch, "sweep": sweep}
     if out is None:
         tree = Path(__file__).resolve().parents[2] / "benchmarks"
         out = tree if tree.is_dir() else Path.cwd()

@@ -8,7 +8,7 @@ import tempfile
 import time
 from pathlib import Path
 
-BATCH_RUNS = 40
+BATCH_RUNS = 48  # a multiple of 2 cores x 8 SIMD lanes, so that no back end idles a core on the last runs
 RUN_SECONDS = 10.0
 SWEEP_SAMPLES_PER_KIND = 60
 
@@ -88,21 +88,21 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
     """
     from .batch import default_workers, run_batch
 
-    kinds, backends = ("ftsmc", "fxtntsmc"), ("serial", "threads", "prange")
+    kinds, backends = ("ftsmc", "fxtntsmc"), ("serial", "threads", "simd", "prange")
     preps, prep_ms = {}, {}
     for kind in kinds:
         _preps(kind, 2, duration)  # first call pays imports and one-off caches
         t0 = time.perf_counter()
         preps[kind] = _preps(kind, runs, duration)
         prep_ms[kind] = 1e3 * (time.perf_counter() - t0) / runs
-        for backend in ("prange", "serial", "threads"):  # warm; prange first (see below)
+        for backend in ("prange", "serial", "threads", "simd"):  # warm (and compile); prange first (see below)
             run_batch(preps[kind][:2], backend=backend)
     rates: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
-    # controllers and the serial and thread-pool back ends interleaved (a slow spell of the
+    # controllers and the serial, thread-pool and SIMD back ends interleaved (a slow spell of the
     # machine hits them alike); prange in a block of its own, last: after a prange call the
     # OpenMP layer's threads keep spinning for a while and would steal the core from a serial
     # or thread-pool run that followed at once
-    for block in (("serial", "threads"), ("prange",)):
+    for block in (("serial", "threads", "simd"), ("prange",)):
         for _ in range(repeat):
             for backend in block:
                 for kind in kinds:
@@ -158,6 +158,61 @@ def bench_sweep(*, repeat: int = 3, workers: tuple[int, ...] = (1, 2), duration:
     return rows
 
 
+def batch_efficiency(row: dict, us_per_step: float, dt: float = 0.001) -> float:
+    """Runs per second per core x RK4 steps per run x the single run's seconds per step.
+
+    1 means a core does in the batch what it does in single runs; a SIMD back end that runs L
+    runs per register can exceed 1 (at most about L).
+    """
+    steps = round(row["run_seconds"] / dt)
+    return row["runs_per_s"] / row["cores"] * steps * us_per_step * 1e-6
+
+
+def bench_cold_start(*, duration: float = 1.0) -> dict:
+    """Wall time of ``auvtrack run`` of the Section 4 scenario in a new process with an empty kernel cache.
+
+    What a user waits for on a fresh install: imports, scenario validation, compiling the one
+    kernel the run needs (and nothing else), the run, writing its folder.  Also reports the kernel
+    compile time the run recorded (its cache marker).
+    """
+    import subprocess
+    import sys
+
+    from ..scenario import paper_scenario_path
+
+    with tempfile.TemporaryDirectory() as tmp:
+        env = {**os.environ, "AUVTRACK_CACHE_DIR": str(Path(tmp) / "cache")}
+        load = _load()
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-m", "auvtrack.cli", "run", str(paper_scenario_path()), "--set",
+                               f"sim.duration={duration}", "--out", str(Path(tmp) / "run")], env=env, cwd=tmp,
+                              capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        markers = [json.loads(m.read_text()) for m in (Path(tmp) / "cache").glob("*/kernels/*.compiled.json")]
+    if proc.returncode != 0:
+        raise RuntimeError(f"cold run failed: {proc.stderr.strip()[-500:]}")
+    return {"seconds": round(wall, 2), "compile_seconds": round(sum(m["seconds"] for m in markers), 2),
+            "kernels_compiled": [m["kernel"] for m in markers], "run_seconds": duration, "load_avg_1min": load}
+
+
+def bench_cold_warmup() -> dict:
+    """Wall time of ``auvtrack warmup`` (every registered controller on every plant) with an empty cache."""
+    import subprocess
+    import sys
+
+    with tempfile.TemporaryDirectory() as tmp:
+        env = {**os.environ, "AUVTRACK_CACHE_DIR": str(Path(tmp) / "cache")}
+        load = _load()
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-m", "auvtrack.cli", "warmup"], env=env, cwd=tmp,
+                              capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise RuntimeError(f"cold warmup failed: {proc.stderr.strip()[-500:]}")
+    doc = json.loads(proc.stdout.strip().splitlines()[-1])
+    return {"seconds": round(wall, 2), "kernels": len(doc["kernels"]), "load_avg_1min": load}
+
+
 def write_results(doc: dict, out: Path) -> None:
     """Write ``results.json`` and ``results.md`` (medians and ratios) into ``out``."""
     import datetime
@@ -196,10 +251,25 @@ def write_results(doc: dict, out: Path) -> None:
                   "| variant | CPU µs / step |", "|---|---|"]
         lines += [f"| {r['variant']} | {r['cpu_us_per_step']:.2f} |" for r in doc["breakdown"]]
         lines += [""]
+    if doc.get("cold"):
+        c, w = doc["cold"], doc.get("cold_warmup")
+        lines += ["## Time to the first result (empty kernel cache, new process)", "",
+                  "| what | wall s | load before |", "|---|---|---|",
+                  f"| `auvtrack run` Section 4 ({c['run_seconds']:g} s), compiling {', '.join(c['kernels_compiled'])} "
+                  f"({c['compile_seconds']:.1f} s of it) | {c['seconds']:.1f} | {c['load_avg_1min']} |"]
+        if w:
+            lines += [f"| `auvtrack warmup`: {w['kernels']} kernels (every registered controller on every plant) | "
+                      f"{w['seconds']:.1f} | {w['load_avg_1min']} |"]
+        lines += [""]
     lines += ["## Batch runner (metrics only, 10 s runs at dt = 1 ms)", "",
-              "| controller | back end | runs / s (median) | best | prepare ms / run (serial Python) | load after |",
-              "|---|---|---|---|---|---|"]
+              "Efficiency = runs / s per core x steps per run x the single run's wall µs per step (table above): 1 "
+              "is a core doing in the batch what it does in single runs; `simd` runs several simulations in the "
+              "lanes of one SIMD register.", "",
+              "| controller | back end | runs / s (median) | best | efficiency | prepare ms / run (serial Python) | "
+              "load after |",
+              "|---|---|---|---|---|---|---|"]
     lines += [f"| {r['controller']} | {r['backend']} | {r['runs_per_s']:.1f} | {r['max_runs_per_s']:.1f} | "
+              f"{batch_efficiency(r, single[r['controller']]['us_per_step']):.2f} | "
               f"{r['prepare_ms_per_run']:.2f} | {r['load_avg_1min']} |" for r in doc["batch"]]
     lines += ["", "## Sweep on Dask distributed (LocalCluster, processes, 1 thread each)", "",
               f"{doc['sweep'][0]['samples']} samples of {doc['sweep'][0]['run_seconds']:g} s (half FTSMC, half "
