@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/compile_profile.py fxtntsmc            # [--plant 5dof] [--top 25] [--json out.json]
+    python benchmarks/compile_profile.py fxtntsmc            # [--plant 5dof] [--lanes] [--top 25] [--json out.json]
 
 Runs in a child process with an empty cache folder (``AUVTRACK_CACHE_DIR`` in a temp dir) and
 compiles the (controller, plant) kernel once, recording Numba's compiler events
@@ -29,20 +29,26 @@ import json, sys, time
 from collections import defaultdict
 from numba.core import event as ev
 
-stack = []                     # [kind, name, t_start, child_time]
+import threading
+_tls = threading.local()       # per thread: [kind, name, t_start, child_time] and the function compiling
 excl = defaultdict(float)      # (kind, name) -> exclusive seconds
 count = defaultdict(int)
 fn_excl = defaultdict(float)   # function qualname -> exclusive seconds over all its events
 fn_llvm = defaultdict(float)   # the part of it inside LLVM
 compiles = defaultdict(list)   # qualname -> signatures compiled
-current_fn = []
+
+def _stack():
+    if not hasattr(_tls, "stack"):
+        _tls.stack, _tls.fn = [], []
+    return _tls.stack, _tls.fn
 
 class L(ev.Listener):
     def on_start(self, e):
+        stack, current_fn = _stack()
         name = ""
         if e.kind == "numba:compile":
             d = e.data["dispatcher"]
-            name = d.py_func.__module__ + "." + d.py_func.__qualname__
+            name = f"{d.py_func.__module__}.{d.py_func.__qualname__}"
             compiles[name].append(str(e.data["args"]))
             current_fn.append(name)
         elif e.kind == "numba:run_pass":
@@ -52,6 +58,7 @@ class L(ev.Listener):
         stack.append([e.kind, name, time.perf_counter(), 0.0])
 
     def on_end(self, e):
+        stack, current_fn = _stack()
         kind, name, t0, child = stack.pop()
         dt = time.perf_counter() - t0
         if stack:
@@ -74,10 +81,21 @@ from auvtrack.simulation import kernels
 from auvtrack.control import CONTROLLERS
 from auvtrack.plant import PLANTS
 t_import = time.perf_counter() - t0
-c, p = sys.argv[1], sys.argv[2]
+c, p, lanes = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
 key = kernels.KernelKey(CONTROLLERS[c].module, PLANTS[p].module, f"{c} on {p}")
+if lanes:  # the SIMD batch kernel (its scalar kernel first, not counted)
+    from auvtrack.runner.batch import run_batch
+    from auvtrack.scenario import load_scenario, paper_scenario_path
+    from auvtrack.simulation.api import prepare
+    preps = [prepare(load_scenario(paper_scenario_path(), {"controller.kind": c, "sim.duration": 0.01}))]
+    run_batch(preps, backend="serial")
+    for d in (excl, count, fn_excl, fn_llvm, compiles):
+        d.clear()
 t1, c1 = time.perf_counter(), time.process_time()
-kernels._compile_run(kernels.kernel(key))
+if lanes:
+    run_batch(preps, backend="simd", workers=1)
+else:
+    kernels._compile_run(kernels.kernel(key))
 wall, cpu = time.perf_counter() - t1, time.process_time() - c1
 print(json.dumps({"import_s": t_import, "compile_s": wall, "excl": excl, "count": count, "fn_excl": fn_excl, "fn_llvm": fn_llvm,
                   "compiles": {k: len(v) for k, v in compiles.items()},
@@ -85,12 +103,14 @@ print(json.dumps({"import_s": t_import, "compile_s": wall, "excl": excl, "count"
 """
 
 
-def profile(controller: str, plant: str = "5dof") -> dict:
-    """Compile one kernel in a child process with an empty cache; return the event totals."""
+def profile(controller: str, plant: str = "5dof", lanes: bool = False) -> dict:
+    """Compile one kernel (``lanes``: its SIMD batch kernel) in a child process with an empty cache; return the event totals."""
     with tempfile.TemporaryDirectory() as tmp:
         env = {**os.environ, "AUVTRACK_CACHE_DIR": tmp, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-        proc = subprocess.run([sys.executable, "-c", CHILD, controller, plant], env=env, cwd=tmp,
-                              capture_output=True, text=True, check=True)
+        proc = subprocess.run([sys.executable, "-c", CHILD, controller, plant, "1" if lanes else "0"], env=env, cwd=tmp,
+                              capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise SystemExit(f"the compile failed:\n{proc.stderr[-3000:]}")
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
@@ -99,11 +119,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("controller")
     ap.add_argument("--plant", default="5dof")
+    ap.add_argument("--lanes", action="store_true", help="the SIMD batch kernel (backend='simd') instead")
     ap.add_argument("--top", type=int, default=25)
     ap.add_argument("--json", type=Path, default=None, help="also write the raw record here")
     args = ap.parse_args()
     load = os.getloadavg()[0]
-    doc = profile(args.controller, args.plant)
+    doc = profile(args.controller, args.plant, args.lanes)
     doc["load_avg_1min_before"] = load
     if args.json:
         args.json.write_text(json.dumps(doc, indent=1))

@@ -252,8 +252,10 @@ def test_a_law_without_lane_form_runs_on_threads(tmp_path):
                 s += g
             return ftsmc_control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work) + int(s - 3.0)
     '''))
+    from auvtrack.runner.batch import MIN_LANES
+
     base = [prepare(load_scenario(PAPER, {"controller.kind": "ftsmc", "seed": i, "sim.duration": 0.2}))
-            for i in range(3)]
+            for i in range(max(MIN_LANES, 2))]  # enough runs for a block
     preps = [dataclasses.replace(p, key=kernels.KernelKey(str(law), p.key.plant, "plug-in on 5dof")) for p in base]
     with pytest.warns(UserWarning, match="no lane form"):
         out = run_batch(preps, backend="simd", workers=2)
@@ -281,3 +283,11 @@ def test_lane_kernel_lives_next_to_its_kernel_in_the_keyed_cache():
     assert module.__file__.endswith(f"{key.name}__lanes.py")
     assert "run__lanes = lane_version(" in kernels.lanes_source(key)
     assert math.isfinite(len(kernels.lanes_source(key)))
+
+
+def test_a_few_runs_left_over_use_the_single_run_kernel():
+    """L + 1 runs: one block of L in lanes, the one left over on the single-run kernel; same results."""
+    preps = [prepare(load_scenario(PAPER, {"controller.kind": "ftsmc", "seed": i, "sim.duration": 0.1}))
+             for i in range(L + 1)]
+    for s, p in zip(run_batch(preps, backend="simd", workers=2), preps):
+        _same_run(s, run_prepared(p), bitwise=True)

@@ -215,12 +215,59 @@ def _lane_stack(arrays: list[np.ndarray], lanes: int) -> np.ndarray:
     return np.ascontiguousarray(np.moveaxis(a, 1, -1))
 
 
+MIN_LANES = 4
+"""Fewer runs than this left over in a group run on the single-run kernel rather than in a block of
+mostly empty lanes (a block costs about what 3 single runs cost, ``benchmarks/results.md``)."""
+
+
+class _LaneGroup:
+    """The runs of one group stacked in blocks of LANES along a last axis, with the lane kernel's outputs."""
+
+    def __init__(self, module, ps: list[Prepared], stop: StopSignal) -> None:
+        L = engine.LANES
+        self.module, self.ps, n = module, ps, len(ps)
+        self.nb = nb = -(-n // L)
+        accs0 = []
+        for _ in range(n):
+            a = np.empty(METRICS_SIZE)
+            metrics_init(a)
+            accs0.append(a)
+        self.accs = _lane_stack(accs0, L)
+        self.fails = np.zeros((nb, 2, ps[0].n_state, L))
+        self.infos = np.zeros((nb, engine.INFO_SIZE, L), dtype=np.int64)
+        stop.register(np.moveaxis(self.infos, 1, -1))  # a view: the stop flag reaches every lane
+        counts = np.array([min(L, n - b * L) for b in range(nb)], dtype=np.int64)
+        self.causes = np.zeros((nb, L), dtype=np.int64)
+        self.t_stops = np.zeros((nb, L))
+        logs = np.zeros((nb, 0, len(ps[0].channels), L))
+        self.args = (_lane_stack([p.plant.pp for p in ps], L), _lane_stack([p.plant.x0 for p in ps], L),
+                     _lane_stack([p.cp for p in ps], L), _lane_stack([p.controller.x0 for p in ps], L),
+                     _lane_stack([p.vp_nom for p in ps], L), _lane_stack([p.environment.rows for p in ps], L),
+                     _lane_stack([p.environment.current for p in ps], L),
+                     _lane_stack([p.environment.noise for p in ps], L), _lane_stack([p.ref_p for p in ps], L),
+                     _lane_stack([p.si for p in ps], L), _lane_stack([p.sf for p in ps], L), logs, self.accs,
+                     self.fails, self.infos, counts, self.causes, self.t_stops)
+
+    def run_block(self, b: int) -> None:
+        """Run block ``b`` (the kernel releases the GIL)."""
+        self.module.run_lanes(*self.args, b, b + 1)
+
+    def summary(self, k: int) -> RunSummary:
+        """The outcome of the group's run ``k``."""
+        b, lane = divmod(k, engine.LANES)
+        p = self.ps[k]
+        o = Outputs(np.empty((0, len(p.channels))), np.ascontiguousarray(self.accs[b, :, lane]),
+                    np.ascontiguousarray(self.fails[b, :, :, lane]), np.ascontiguousarray(self.infos[b, :, lane]))
+        return _summary(p, int(self.causes[b, lane]), float(self.t_stops[b, lane]), o)
+
+
 def _run_simd(preps: Sequence[Prepared], stop: StopSignal, workers: int) -> list[RunSummary]:
     """Runs grouped by kernel and array shapes, each group in blocks of LANES runs (one per SIMD lane).
 
-    Within a group, runs are sorted by length so that a block's lanes end together; blocks are
-    spread over ``workers`` threads (the lane kernel releases the GIL).  A group whose kernel has
-    no lane form (:class:`~auvtrack.simulation.lanes.NotLaneable`) runs on the thread back end.
+    Within a group, runs are sorted by length so that a block's lanes end together; the blocks, and
+    the runs that go to the single-run kernel (fewer than :data:`MIN_LANES` left over in a group, or
+    a group whose law or plant has no lane form, :class:`~auvtrack.simulation.lanes.NotLaneable`,
+    which is warned about) are spread over ``workers`` threads.
     """
     from ..simulation.lanes import NotLaneable
 
@@ -229,52 +276,37 @@ def _run_simd(preps: Sequence[Prepared], stop: StopSignal, workers: int) -> list
     for i, p in enumerate(preps):
         groups.setdefault(_shape_key(p), []).append(i)
     out: list[RunSummary | None] = [None] * len(preps)
+    lane_groups: list[tuple[list[int], _LaneGroup]] = []
+    singles: list[int] = []
     for idx in groups.values():
         idx = sorted(idx, key=lambda i: preps[i].n_steps)
-        ps = [preps[i] for i in idx]
-        try:
-            module = kernels.lanes_module(ps[0].key)
-        except NotLaneable as exc:
-            warnings.warn(f"simd back end: {ps[0].key.label or ps[0].key.name} has no lane form ({exc}); "
-                          "its runs use the thread back end", stacklevel=3)
-            with ThreadPoolExecutor(max_workers=workers) as pool:
-                for i, r in zip(idx, pool.map(lambda p: run_metrics(p, stop), ps)):
-                    out[i] = r
+        rest = len(idx) % L
+        if 0 < rest < MIN_LANES:
+            singles += idx[len(idx) - rest:]
+            idx = idx[:len(idx) - rest]
+        if not idx:
             continue
-        n = len(ps)
-        nb = -(-n // L)
-        accs0 = []
-        for _ in range(n):
-            a = np.empty(METRICS_SIZE)
-            metrics_init(a)
-            accs0.append(a)
-        accs = _lane_stack(accs0, L)
-        fails = np.zeros((nb, 2, ps[0].n_state, L))
-        infos = np.zeros((nb, engine.INFO_SIZE, L), dtype=np.int64)
-        stop.register(np.moveaxis(infos, 1, -1))  # a view: the stop flag reaches every lane
-        counts = np.array([min(L, n - b * L) for b in range(nb)], dtype=np.int64)
-        causes = np.zeros((nb, L), dtype=np.int64)
-        t_stops = np.zeros((nb, L))
-        logs = np.zeros((nb, 0, len(ps[0].channels), L))
-        args = (_lane_stack([p.plant.pp for p in ps], L), _lane_stack([p.plant.x0 for p in ps], L),
-                _lane_stack([p.cp for p in ps], L), _lane_stack([p.controller.x0 for p in ps], L),
-                _lane_stack([p.vp_nom for p in ps], L), _lane_stack([p.environment.rows for p in ps], L),
-                _lane_stack([p.environment.current for p in ps], L),
-                _lane_stack([p.environment.noise for p in ps], L), _lane_stack([p.ref_p for p in ps], L),
-                _lane_stack([p.si for p in ps], L), _lane_stack([p.sf for p in ps], L), logs, accs, fails, infos,
-                counts, causes, t_stops)
-        nw = max(1, min(workers, nb))
-        cuts = [round(j * nb / nw) for j in range(nw + 1)]
-        if nw == 1:
-            module.run_lanes(*args, 0, nb)
-        else:
-            with ThreadPoolExecutor(max_workers=nw) as pool:
-                list(pool.map(lambda j: module.run_lanes(*args, cuts[j], cuts[j + 1]), range(nw)))
+        try:
+            module = kernels.lanes_module(preps[idx[0]].key)
+        except NotLaneable as exc:
+            key = preps[idx[0]].key
+            warnings.warn(f"simd back end: {key.label or key.name} has no lane form ({exc}); "
+                          "its runs use the thread back end", stacklevel=3)
+            singles += idx
+            continue
+        lane_groups.append((idx, _LaneGroup(module, [preps[i] for i in idx], stop)))
+    tasks: list[Callable[[], Any]] = [lambda g=g, b=b: g.run_block(b) for _, g in lane_groups for b in range(g.nb)]
+    tasks += [lambda i=i: out.__setitem__(i, run_metrics(preps[i], stop)) for i in singles]
+    if workers == 1 or len(tasks) == 1:
+        for task in tasks:
+            task()
+    else:
+        with ThreadPoolExecutor(max_workers=min(workers, len(tasks))) as pool:
+            for f in [pool.submit(task) for task in tasks]:
+                f.result()
+    for idx, g in lane_groups:
         for k, i in enumerate(idx):
-            b, l = divmod(k, L)
-            o = Outputs(np.empty((0, len(ps[0].channels))), np.ascontiguousarray(accs[b, :, l]),
-                        np.ascontiguousarray(fails[b, :, :, l]), np.ascontiguousarray(infos[b, :, l]))
-            out[i] = _summary(preps[i], int(causes[b, l]), float(t_stops[b, l]), o)
+            out[i] = g.summary(k)
     return out  # type: ignore[return-value]
 
 

@@ -158,7 +158,8 @@ from {key.plant.rsplit('.', 1)[0]} import {key.plant.rsplit('.', 1)[1]} as plant
 
 law = llvm_inline(law_module({key.law!r}).control)  # one compilation, inlined by LLVM where called
 '''
-    return head + "\n\n" + "\n\n".join(parts)
+    tail = "\n\nlog_row.lane_stub = True  # the SIMD batch kernels keep no trajectory (metrics only)\n"
+    return head + "\n\n" + "\n\n".join(parts) + tail
 
 
 def lanes_source(key: KernelKey) -> str:

@@ -260,6 +260,10 @@ class _Rewriter:
             if isinstance(node.func, ast.Attribute) and node.func.attr == "copy" and not args and obj is None:
                 return _h("lane_copy", self.expr(node.func.value), _name("_m"))
             if target is not None:
+                # a float or boolean constant argument becomes lanes: one compiled form of the callee
+                # whether a caller passes a constant or a lane value (integers stay: indices)
+                args = [_h("lanes_like", _name("_m"), a) if isinstance(a, ast.Constant) and isinstance(
+                    a.value, (bool, float)) else a for a in args]
                 return ast.Call(func=_name(target), args=args + [_name("_m")], keywords=[])
             return ast.Call(func=self.expr(node.func), args=args, keywords=[])
         if isinstance(node, (ast.Lambda, ast.ListComp, ast.GeneratorExp, ast.DictComp, ast.SetComp, ast.Await,
@@ -531,6 +535,14 @@ class _Rewriter:
                                type_params=[], lineno=1)
 
 
+def _stub(disp):
+    """The lane form of a procedure the lane kernels never run: the same parameters, does nothing."""
+    params = list(inspect.signature(disp.py_func).parameters)
+    ns: dict = {"__name__": disp.py_func.__module__}
+    exec(f"def {disp.py_func.__name__}__stub({', '.join(params + ['_m'])}):\n    return None\n", ns)  # noqa: S102
+    return njit(cache=False, forceinline=True)(ns[f"{disp.py_func.__name__}__stub"])
+
+
 def _range_params(fdef: ast.FunctionDef) -> list[str]:
     """Parameters that appear in the arguments of a ``range`` (loop bounds, e.g. a number of neurons)."""
     params = {a.arg for a in fdef.args.args}
@@ -610,6 +622,11 @@ def lane_version(disp):
         if got is not None:
             return got
         fn = disp.py_func
+        if getattr(disp, "lane_stub", False):  # a function the lane kernels never run (the logger)
+            out = _stub(disp)
+            _CACHE[disp] = out
+            _SOURCES[disp] = "(stub: does nothing)\n"
+            return out
         scope = _scope(fn)
         callees: dict[str, Any] = {}
 
