@@ -98,6 +98,7 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
         for backend in ("prange", "serial", "threads", "simd"):  # warm (and compile); prange first (see below)
             run_batch(preps[kind][:2], backend=backend)
     rates: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
+    cpu: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
     # controllers and the serial, thread-pool and SIMD back ends interleaved (a slow spell of the
     # machine hits them alike); prange in a block of its own, last: after a prange call the
     # OpenMP layer's threads keep spinning for a while and would steal the core from a serial
@@ -106,11 +107,13 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
         for _ in range(repeat):
             for backend in block:
                 for kind in kinds:
-                    t0 = time.perf_counter()
+                    t0, c0 = time.perf_counter(), time.process_time()
                     run_batch(preps[kind], backend=backend)
                     rates[(kind, backend)].append(runs / (time.perf_counter() - t0))
+                    cpu[(kind, backend)].append((time.process_time() - c0) / runs)
     return [{"controller": kind, "backend": backend, "runs": runs, "run_seconds": duration,
              "runs_per_s": round(statistics.median(r), 2), "max_runs_per_s": round(max(r), 2),
+             "cpu_ms_per_run": round(1e3 * statistics.median(cpu[(kind, backend)]), 3),
              "prepare_ms_per_run": round(prep_ms[kind], 3), "cores": default_workers(), "repeat": repeat,
              "load_avg_1min": _load()} for (kind, backend), r in rates.items()]
 
@@ -166,6 +169,16 @@ def batch_efficiency(row: dict, us_per_step: float, dt: float = 0.001) -> float:
     """
     steps = round(row["run_seconds"] / dt)
     return row["runs_per_s"] / row["cores"] * steps * us_per_step * 1e-6
+
+
+def batch_cpu_efficiency(row: dict, cpu_us_per_step: float, dt: float = 0.001) -> float:
+    """The single run's CPU time per run over the batch's CPU time per run (all threads of the process).
+
+    :func:`batch_efficiency` from CPU time instead of wall time: less disturbed by other processes
+    on a shared machine (it cannot see two threads slowing each other down on one core).
+    """
+    steps = round(row["run_seconds"] / dt)
+    return steps * cpu_us_per_step * 1e-3 / row["cpu_ms_per_run"]
 
 
 def bench_cold_start(*, duration: float = 1.0) -> dict:
@@ -265,12 +278,18 @@ def write_results(doc: dict, out: Path) -> None:
               "Efficiency = runs / s per core x steps per run x the single run's wall µs per step (table above): 1 "
               "is a core doing in the batch what it does in single runs; `simd` runs several simulations in the "
               "lanes of one SIMD register.", "",
-              "| controller | back end | runs / s (median) | best | efficiency | prepare ms / run (serial Python) | "
-              "load after |",
-              "|---|---|---|---|---|---|---|"]
+              "| controller | back end | runs / s (median) | best | efficiency | CPU ms / run | CPU efficiency | "
+              "prepare ms / run (serial Python) | load after |",
+              "|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['controller']} | {r['backend']} | {r['runs_per_s']:.1f} | {r['max_runs_per_s']:.1f} | "
               f"{batch_efficiency(r, single[r['controller']]['us_per_step']):.2f} | "
-              f"{r['prepare_ms_per_run']:.2f} | {r['load_avg_1min']} |" for r in doc["batch"]]
+              + (f"{r['cpu_ms_per_run']:.2f} | "
+                 f"{batch_cpu_efficiency(r, single[r['controller']]['cpu_us_per_step']):.2f} | "
+                 if "cpu_ms_per_run" in r else "| | ")
+              + f"{r['prepare_ms_per_run']:.2f} | {r['load_avg_1min']} |" for r in doc["batch"]]
+    lines += ["", "CPU efficiency: the single run's CPU time per run (20 s runs, table above) over the batch's "
+              "process CPU time per run; unlike the wall-time efficiency it does not drop when other processes "
+              "take the cores."]
     lines += ["", "## Sweep on Dask distributed (LocalCluster, processes, 1 thread each)", "",
               f"{doc['sweep'][0]['samples']} samples of {doc['sweep'][0]['run_seconds']:g} s (half FTSMC, half "
               "FXTNTSMC, chunks of 10), including per-sample scenario validation and preparation and the "
