@@ -986,25 +986,47 @@ def _masked_typing(fn, typingctx, m, args):
     def codegen(context, builder, sig, cargs):
         mask, vals = cargs[0], cargs[1:]
         impl = context.get_function(fnty, ssig)
-        out = ir.Constant(context.get_value_type(ret), ir.Undefined)
-        for k in range(count):
-            on = builder.extract_element(mask, _i32(k))
-            with builder.if_else(on) as (then, otherwise):
-                with then:
-                    xs = [_scalar_cast(context, builder, _lane(builder, v, k), t.dtype, s) if isinstance(t, Lanes)
-                          else context.cast(builder, v, types.unliteral(t), s)
-                          for v, t, s in zip(vals, args, ssig.args)]
-                    r = _scalar_cast(context, builder, impl(builder, xs), ssig.return_type, ret.dtype)
-                    bb_then = builder.block
-                with otherwise:
-                    bb_else = builder.block
-            phi = builder.phi(r.type)
-            phi.add_incoming(r, bb_then)
-            phi.add_incoming(ir.Constant(r.type, None), bb_else)
-            out = builder.insert_element(out, phi, _i32(k))
-        return out
+
+        def lane_args(k):
+            return [_scalar_cast(context, builder, _lane(builder, v, k), t.dtype, s) if isinstance(t, Lanes)
+                    else context.cast(builder, v, types.unliteral(t), s) for v, t, s in zip(vals, args, ssig.args)]
+
+        vty = context.get_value_type(ret)
+        every = _vcall(builder, "llvm.vector.reduce.and", [mask], ir.IntType(1))
+        with builder.if_else(every, likely=True) as (all_on, some_off):
+            with all_on:  # the usual case: every lane, without a branch per lane
+                full = ir.Constant(vty, ir.Undefined)
+                for k in range(count):
+                    r = _scalar_cast(context, builder, impl(builder, lane_args(k)), ssig.return_type, ret.dtype)
+                    full = builder.insert_element(full, r, _i32(k))
+                bb_full = builder.block
+            with some_off:
+                part = _masked_lanes(context, builder, impl, mask, lane_args, ssig, ret, count)
+                bb_part = builder.block
+        phi = builder.phi(vty)
+        phi.add_incoming(full, bb_full)
+        phi.add_incoming(part, bb_part)
+        return phi
 
     return signature(ret, m, *args), codegen
+
+
+def _masked_lanes(context, builder, impl, mask, lane_args, ssig, ret, count):
+    """Per lane: the scalar function where the mask is set, 0 elsewhere."""
+    out = ir.Constant(context.get_value_type(ret), ir.Undefined)
+    for k in range(count):
+        on = builder.extract_element(mask, _i32(k))
+        with builder.if_else(on) as (then, otherwise):
+            with then:
+                r = _scalar_cast(context, builder, impl(builder, lane_args(k)), ssig.return_type, ret.dtype)
+                bb_then = builder.block
+            with otherwise:
+                bb_else = builder.block
+        phi = builder.phi(r.type)
+        phi.add_incoming(r, bb_then)
+        phi.add_incoming(ir.Constant(r.type, None), bb_else)
+        out = builder.insert_element(out, phi, _i32(k))
+    return out
 
 
 def _masked(fn, nargs: int):

@@ -94,8 +94,26 @@ def _lane_signature(width: int, args) -> types.Type | None:
     return types.UniTuple(Lanes(types.float64, L), width)(*args)
 
 
-WIDE = {"_ZGVdN4vv_pow": "_ZGVeN8vv_pow", "_ZGVdN4v_exp": "_ZGVeN8v_exp", "_ZGVdN4v_sin": "_ZGVeN8v_sin",
-        "_ZGVdN4v_cos": "_ZGVeN8v_cos"}
+WIDE_PAIRS = {"_ZGVdN4vv_pow": "_ZGVeN8vv_pow", "_ZGVdN4v_exp": "_ZGVeN8v_exp", "_ZGVdN4v_sin": "_ZGVeN8v_sin",
+              "_ZGVdN4v_cos": "_ZGVeN8v_cos"}
+"""4-lane AVX2 libmvec functions and their 8-lane AVX-512 forms that return the same bits (glibc 2.36,
+``tests/test_vecmath.py`` on 10^5 inputs each, specials included); the 8-lane ``atanh`` does not, so
+it is not here.  Used by lane kernels of 8 runs (:mod:`auvtrack._lanes`): one call per 8 runs."""
+
+
+def _wide() -> dict[str, str]:
+    if BACKEND != "avx2" or os.environ.get("AUVTRACK_LIBMVEC_AVX512", "1") == "0":
+        return {}
+    import llvmlite.binding as ll
+
+    if not ll.get_host_cpu_features().get("avx512f", False):
+        return {}
+    handle = ctypes.CDLL(ctypes.util.find_library("mvec"))
+    return {k: v for k, v in WIDE_PAIRS.items() if hasattr(handle, v)}
+
+
+WIDE = _wide()
+"""The pairs of :data:`WIDE_PAIRS` this machine can use (empty: no AVX-512, or libmvec lacks them)."""
 
 
 def _lane_call(name: str, width: int):

@@ -40,7 +40,7 @@ from ..simulation.result import Result
 BACKENDS = ("threads", "prange", "serial", "simd")
 
 __all__ = ["RunSummary", "run_metrics", "run_batch", "iter_batch", "BACKENDS", "default_workers", "StopSignal",
-           "BatchInterrupted"]
+           "BatchInterrupted", "preferred_backend"]
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,27 @@ class RunSummary:
     def ok(self) -> bool:
         """True when the run reached its end without failure."""
         return self.status == "ok"
+
+
+def preferred_backend(threads: str = "threads") -> str:
+    """The back end for many metrics-only runs: ``"simd"`` where the vector math library is in use, else ``threads``.
+
+    Without libmvec (``auvtrack._vecmath.BACKEND == "scalar"``) every vector math call of a lane
+    kernel becomes one scalar call per lane, and the lanes lose most of their advantage.
+
+    Parameters
+    ----------
+    threads : str, optional
+        The back end to use otherwise (``"serial"`` for one core per process, as in a Dask worker).
+
+    Returns
+    -------
+    str
+        A name of :data:`BACKENDS`.
+    """
+    from .._vecmath import BACKEND
+
+    return "simd" if BACKEND == "avx2" else threads
 
 
 def default_workers() -> int:

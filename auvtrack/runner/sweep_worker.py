@@ -89,14 +89,15 @@ def run_chunk(spec: StudySpec, chunk: int):
     """
     import pyarrow as pa
 
-    from .batch import run_batch
+    from .batch import preferred_backend, run_batch
     from ..simulation.metrics import METRIC_NAMES
 
     schema = result_schema(spec)
     indices = list(spec.chunk_range(chunk))
     prepared = [_prepare_sample(spec, i) for i in indices]
     runnable = [p for _, p in prepared if not isinstance(p, str)]
-    summaries = iter(run_batch(runnable, backend="simd", workers=1))  # one core per worker, its SIMD lanes
+    # one core per worker: its SIMD lanes (runner.batch.preferred_backend)
+    summaries = iter(run_batch(runnable, backend=preferred_backend("serial"), workers=1))
     cols: dict[str, list] = {f.name: [] for f in schema}
     for i, (seed, prep) in zip(indices, prepared):
         point, rep, _ = spec.sample(i)
