@@ -1,11 +1,18 @@
-"""Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce | study | sweep``.
+"""Command line: ``auvtrack reproduce | run | check | bounds | study | sweep | bench | warmup``.
 
-Bad input (a scenario error, a missing file, an invalid gain) prints ONE line to stderr and
-exits with status 2, never a traceback.  A simulation that fails (divergence, pitch limit,
-envelope violation) keeps and saves its partial result, prints the diagnostic and exits 3.
+Bad input (a scenario error, a missing file, an invalid gain, a run over the plan's limits, an
+output folder that cannot be written) prints ONE line to stderr and exits with status 2, never a
+traceback, and before anything runs.  ``check`` runs exactly the validation of ``run`` (load,
+plan, controller set-up), so it refuses the same scenarios with the same message.  A simulation
+that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
+prints the diagnostic and exits 3.  Ctrl-C stops a run within about a second, saves what was
+computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps its
+completed chunks for ``--resume`` and exits 130.  ``auvtrack --help`` lists every command and
+these exit codes.
 """
 from __future__ import annotations
 
+import inspect
 import json
 import sys
 import warnings
@@ -15,6 +22,10 @@ import click
 
 EXIT_BAD_INPUT = 2
 EXIT_SIM_FAILED = 3
+EXIT_INTERRUPTED = 130
+MAX_WORKERS = 256
+MAX_REPEAT = 1000
+LONG_RUN_STEPS = 1_000_000  # runs this long announce themselves (and that Ctrl-C keeps their result)
 
 
 class BadInput(click.ClickException):
@@ -32,36 +43,116 @@ def _load(scenario: str, overrides: tuple[str, ...]):
     return load_scenario(scenario, list(overrides))
 
 
+def _prepare(scenario: str, sc):
+    """The run's validation after loading: plan and controller set-up (``check`` = ``run`` minus the run)."""
+    from .simulation.api import prepare
+
+    try:
+        return prepare(sc)
+    except ValueError as exc:  # ScenarioError of the plan, or a controller refusing its set-up
+        raise BadInput(f"{scenario}: {_one_line(exc)}") from None
+
+
+def _mib(n: int) -> str:
+    return f"{n / 2 ** 20:.3g} MiB"
+
+
 def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split()) or type(exc).__name__
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+EXIT_CODES = (("0", "success"),
+              ("2", "bad input: one line naming the field and the allowed range, no traceback, nothing run"),
+              ("3", "a simulation failed (diverged, pitch limit, envelope violated): the diagnostic is printed "
+                    "and the partial result kept"),
+              ("130", "interrupted (Ctrl-C): a run keeps its partial result, a sweep its completed chunks"))
+EXIT_CODES_HELP = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + "."
+COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "study", "sweep", "bench", "warmup")
+
+
+def _first_paragraph(text: str | None) -> str:
+    return " ".join(inspect.cleandoc(text or "").split("\n\n")[0].split())
+
+
+class _Group(click.Group):
+    """Top-level group: every command with its whole first help paragraph, then the exit codes."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        names = super().list_commands(ctx)
+        return [n for n in COMMAND_ORDER if n in names] + [n for n in names if n not in COMMAND_ORDER]
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(n, _first_paragraph(c.help)) for n in self.list_commands(ctx)
+                if (c := self.get_command(ctx, n)) is not None and not c.hidden]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+    def format_epilog(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        with formatter.section("Exit status"):
+            formatter.write_dl(list(EXIT_CODES))
+        super().format_epilog(ctx, formatter)
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="auvtrack")
 def cli() -> None:
-    """auvtrack: trajectory-tracking control of underactuated AUVs."""
+    """auvtrack: trajectory-tracking control of underactuated AUVs.
+
+    Scenarios are TOML files in which every key has a default (docs/scenarios.md); an empty
+    file is the paper's Section 4.  Start with `auvtrack reproduce`.  The first command after
+    installing or editing the package compiles the Numba kernels (about a minute, more on a
+    loaded machine; cached on disk afterwards); `auvtrack warmup` does that up front.
+    """
 
 
 set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
                           help="Override a scenario key, e.g. --set sim.dt=0.002 (repeatable).")
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("scenario")
-@click.option("--out", type=click.Path(file_okay=False), default=None, help="Run folder (default runs/<name>).")
+@click.option("--out", default=None, metavar="FOLDER",
+              help="Run folder, replaced as a whole if it exists and holds only a run (default: a new "
+                   "runs/<name>-<controller>, numbered -2, -3, ... when taken).")
 @set_option
 @click.option("--mat", is_flag=True, help="Also write trajectory.mat (MATLAB).")
 def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -> None:
-    """Simulate SCENARIO (a TOML file) and write trajectory.csv and run.json."""
-    from .simulation.api import prepare, run_prepared
+    """Simulate SCENARIO (a TOML file) and write trajectory.csv, run.json and scenario.toml to a run folder.
+
+    Without --out every run gets a new folder runs/<name>-<controller> (then -2, -3, ...), so a
+    second run never overwrites the first; the folder is printed.  The folder is checked before
+    the simulation starts, and scenario.toml reproduces the run (auvtrack run <folder>/scenario.toml).
+    """
+    from .simulation.api import SimulationInterrupted, ensure_compiled, run_prepared
+    from .simulation.result import FolderError, prepare_run_folder
+    from .simulation.run_folder import default_run_folder
 
     sc = _load(scenario, overrides)
-    prep = prepare(sc)
+    prep = _prepare(scenario, sc)
+    target = Path(out) if out is not None else default_run_folder(sc.name, sc.controller.kind)
+    try:  # before the run: an unwritable folder must not cost the simulation
+        prepare_run_folder(target)
+    except FolderError as exc:
+        raise BadInput(f"{'--out' if out is not None else 'run folder'}: {_one_line(exc)}") from None
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
-    res = run_prepared(prep)
-    folder = res.save(Path(out) if out else Path("runs") / sc.name, mat=mat or sc.output.mat)
+    ensure_compiled([prep])  # compile or load the kernel first: Ctrl-C from here on stops the simulation
+    if prep.n_steps >= LONG_RUN_STEPS:
+        click.echo(f"running {prep.n_steps} RK4 steps (Ctrl-C stops the run and keeps its partial result)", err=True)
+    try:
+        res = run_prepared(prep)
+    except SimulationInterrupted as exc:  # stopped within about a second; write what was computed
+        res = exc.result
+    try:
+        folder = res.save(target, mat=mat or sc.output.mat, overwrite=out is not None)
+    except OSError as exc:  # FolderError (the folder changed since the check), a full disk...
+        click.echo(f"auvtrack: error: the run folder {target} could not be written: {_one_line(exc)}", err=True)
+        raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
+    if res.status == "interrupted":
+        click.echo(f"auvtrack: interrupted at t = {res.failure['time']:.6g} s after {res.meta['steps']} of "
+                   f"{prep.n_steps} steps; partial result kept in {folder}", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED)
     if not res.ok:
         f = res.failure
         click.echo(f"auvtrack: simulation failed at t = {f['time']:.6g} s: {f['cause']}: {f['detail']}; "
@@ -69,19 +160,29 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         raise click.exceptions.Exit(EXIT_SIM_FAILED)
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("scenario")
 @set_option
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
-    """Validate SCENARIO without running it."""
+    """Validate SCENARIO and its --set overrides as run would (load, plan, controller set-up), without simulating.
+
+    Warns where Theorem 1's conditions fail.
+    """
+    from .scenario.plan import plan_run
+
     sc = _load(scenario, overrides)
+    prep = _prepare(scenario, sc)
+    for note in prep.notes:
+        click.echo(f"warning: {note}", err=True)
     if sc.controller.kind == "fxtntsmc":
         from .control.theory import check_theorem1
 
         for v in check_theorem1(sc.controller):
             click.echo(f"warning: {v}", err=True)
+    plan = plan_run(sc, len(prep.channels))
     click.echo(f"ok: {scenario} ({sc.name}: controller {sc.controller.kind}, "
-               f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s)")
+               f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s: {plan.n_steps} steps, {plan.log_rows} logged rows, "
+               f"~{_mib(plan.memory_bytes)})")
 
 
 @cli.command()
@@ -92,7 +193,7 @@ def check(scenario: str, overrides: tuple[str, ...]) -> None:
 @click.option("--g2", default=0.5, show_default=True, help="Tuning constant of eq. (50) in (0, 1).")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of text.")
 def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, g2: float, as_json: bool) -> None:
-    """Print Theorem 1's fixed-time bounds for the gains of SCENARIO."""
+    """Print Theorem 1's fixed-time bounds for the FXTNTSMC gains of SCENARIO, and whether they are vacuous."""
     from .control.theory import fixed_time_bounds
 
     sc = _load(scenario, overrides)
@@ -103,68 +204,107 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 
 
 @cli.command()
-@click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: ftsmc, fxtntsmc).")
+@click.option("--controller", "controllers", multiple=True,
+              help="Controller kind(s), or plugin:FILE.py (default: every built-in controller).")
 @click.option("--repeat", default=7, show_default=True, help="Timed repetitions; the median is reported.")
 @click.option("--duration", default=20.0, show_default=True, help="Simulated seconds per repetition.")
 @click.option("--all", "run_all", is_flag=True,
               help="Full suite: every controller, batch runs/s, sweep throughput on 1 and 2 Dask workers; "
-                   "writes benchmarks/results.{json,md} (or --out).")
+                   "writes results.{json,md} to --out.")
 @click.option("--out", "bench_out", type=click.Path(file_okay=False), default=None,
-              help="Folder for the --all results (default: benchmarks/ of the source tree, else .).")
-def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
-    """Time the compiled closed loop; one JSON line per controller with us_per_step."""
-    from .runner.bench import bench_single
+              help="Folder for the --all results (default: a new folder under ~/.local/share/auvtrack/bench, "
+                   "or $XDG_DATA_HOME; never the source tree unless asked, e.g. --out benchmarks).")
+@click.option("--plant", type=click.Choice(["5dof", "6dof"]), default="5dof", show_default=True,
+              help="Plant model: 5dof (Section 4) or 6dof (each REMUS 100 truth preset, a 1 m/s line).")
+def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None,
+          plant: str = "5dof") -> None:
+    """Time the compiled closed loop: µs per RK4 step, one JSON line per controller (every built-in by default).
+
+    --all runs the full suite (batch runs/s, Dask sweep throughput) and writes results.json and
+    results.md to --out (default: a new user folder; the working tree is left unchanged).
+    """
+    if not 1 <= repeat <= MAX_REPEAT:
+        raise BadInput(f"--repeat: must be in [1, {MAX_REPEAT}] (a median needs at least one timing) (got {repeat})")
+    if not duration > 0:
+        raise BadInput(f"--duration: must be > 0 s (got {duration:g})")
 
     if run_all:
         from .runner.bench import bench_all
 
         doc = bench_all(repeat=repeat, out=Path(bench_out) if bench_out else None, progress=True)
+        folder = doc.pop("out")
         click.echo(json.dumps(doc, indent=2))
+        click.echo(f"written: {folder / 'results.json'}, {folder / 'results.md'}")
         return
-    for kind in controllers or ("ftsmc", "fxtntsmc"):
-        click.echo(json.dumps(bench_single(kind, repeat=repeat, duration=duration)))
+    from .runner.bench import bench_plant, bench_singles, builtin_controllers
+
+    if plant != "5dof":  # issue 11: the 6-DOF truths, one line per (controller, preset)
+        for row in bench_plant(controllers or ("ftsmc", "fxtntsmc"), plant, repeat=repeat, duration=duration):
+            click.echo(json.dumps(row))
+        return
+    for row in bench_singles(controllers or builtin_controllers(), repeat=repeat, duration=duration):
+        click.echo(json.dumps(row))
 
 
 @cli.command()
 @click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: every one).")
 @click.option("--plant", "plants", multiple=True, help="Plant model(s) (default: every one).")
 def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
-    """Compile every kernel (each controller on each plant) once, in parallel; later runs load them."""
+    """Compile every kernel (each controller on each plant) once, in parallel; later runs load them.
+
+    The first command after installing or editing the package compiles the kernels it needs
+    (about a minute, more on a loaded machine); warmup does it for every command up front.
+    """
     from .runner.bench import warmup as _warmup
 
     click.echo(json.dumps(_warmup(controllers, plants, progress=True)))
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("study")
-@click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default sweeps/<name>).")
+@click.option("--out", default=None, metavar="FOLDER", help="Output folder (default sweeps/<name>).")
 @click.option("--workers", type=int, default=None, help="Worker processes of the local Dask cluster (default: cores).")
+@click.option("--worker-memory", default="1GiB", show_default=True, metavar="SIZE",
+              help="Memory limit of each local worker (e.g. 2GiB); a sample that would not fit is recorded as failed.")
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Use an existing Dask scheduler, tcp://host:port.")
 @click.option("--resume", is_flag=True, help="Finish an interrupted sweep in --out (completed chunks are kept).")
 @click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def sweep(study: str, out: str | None, workers: int | None, scheduler: str | None, resume: bool,
+def sweep(study: str, out: str | None, workers: int | None, worker_memory: str, scheduler: str | None, resume: bool,
           max_chunks: int | None, quiet: bool) -> None:
-    """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask."""
-    from .runner.sweep import run_sweep
+    """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask: Parquet rows, quantiles, --resume.
+
+    The study format is docs/sweeps.md; scenarios/sweep_example.toml is an example.
+    """
+    from .runner.sweep import parse_memory, run_sweep
     from .runner.sweep_schema import load_study
 
     if workers is not None and scheduler:
         raise BadInput("--workers and --scheduler exclude each other (the scheduler's cluster has its workers)")
-    if workers is not None and workers < 1:
-        raise BadInput(f"--workers: must be >= 1 (got {workers})")
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise BadInput(f"--workers: must be in [1, {MAX_WORKERS}] (got {workers})")
+    parse_memory(worker_memory)
     spec = load_study(study)
     folder = Path(out) if out else Path("sweeps") / spec.study.name
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        raise BadInput(f"--out: {folder}: is {'a symbolic link' if folder.is_symlink() else 'a file'}, not a folder")
 
     def _stop(signum, frame):  # SIGTERM / SIGINT: stop cleanly (cluster closed, chunks kept for --resume)
         raise KeyboardInterrupt
 
     import signal
 
-    handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)}
+    import threading
+
+    main_thread = threading.current_thread() is threading.main_thread()  # signals are the main thread's
+    handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)} if main_thread else {}
     try:
         res = run_sweep(spec, folder, workers=workers, scheduler=scheduler, resume=resume, max_chunks=max_chunks,
-                        progress=not quiet)
+                        progress=not quiet, memory_limit=worker_memory)
+    except KeyboardInterrupt:
+        click.echo(f"auvtrack: sweep interrupted (the cluster is closed, completed chunks are kept); finish with: "
+                   f"auvtrack sweep {study} --out {folder} --resume", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
     finally:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
@@ -176,14 +316,20 @@ def sweep(study: str, out: str | None, workers: int | None, scheduler: str | Non
 
 
 @cli.command()
-@click.option("--out", type=click.Path(file_okay=False), default="reproduce", show_default=True)
+@click.option("--out", type=click.Path(file_okay=False), default="reproduce", show_default=True,
+              help="Output folder (overwritten).")
 @click.option("--quick", is_flag=True, help="Short horizon (smoke test).")
 def reproduce(out: str, quick: bool) -> None:
-    """Reproduce the paper's Section 4: both controllers, Figures 3-8, metrics and verdicts."""
+    """Reproduce the paper's Section 4: both controllers, Figures 3-8, metrics and a verdict on each claim.
+
+    Writes the run folders, figures/, metrics.json, summary.md and report.html (one
+    self-contained page with every figure) to --out.
+    """
     from .studies.reproduce import reproduce as _reproduce
 
     summary = _reproduce(Path(out), quick=quick, progress=True)
     click.echo(summary)
+    click.echo(f"written: {Path(out) / 'summary.md'}, {Path(out) / 'report.html'}")
 
 
 class _StudyCommand(click.Command):
@@ -202,7 +348,7 @@ class _StudyCommand(click.Command):
 @click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default studies/<NAME>).")
 @click.option("--quick", is_flag=True, help="CI-sized run (seconds instead of minutes).")
 def study(name: str, out: str | None, quick: bool) -> None:
-    """Run study NAME and write its report.md, results.json and figures (NAME 'list': list studies)."""
+    """Run study NAME and write report.md, report.html, results.json and figures/ (NAME 'list': list them)."""
     from .studies.registry import all_studies, get_study
 
     if name == "list":
@@ -214,7 +360,8 @@ def study(name: str, out: str | None, quick: bool) -> None:
     except KeyError as e:
         raise BadInput(str(e.args[0])) from None
     report = spec.run(Path(out) if out else Path("studies") / name, quick=quick, progress=True)
-    click.echo(f"report: {report}")
+    html = report.with_suffix(".html")
+    click.echo(f"report: {report}" + (f", {html}" if html.exists() else ""))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -226,12 +373,16 @@ def main(argv: list[str] | None = None) -> int:
         rv = cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
     except click.exceptions.Exit as e:
         return e.exit_code
+    except click.UsageError as e:  # one line too, with where to look
+        where = f" (see '{e.ctx.command_path} --help')" if e.ctx is not None else ""
+        click.echo(f"auvtrack: error: {_one_line(e.format_message())}{where}", err=True)
+        return EXIT_BAD_INPUT
     except click.ClickException as e:
         e.show()
         return e.exit_code
-    except click.exceptions.Abort:
-        click.echo("auvtrack: aborted", err=True)
-        return 130
+    except click.exceptions.Abort:  # Ctrl-C outside a simulation (loading, compiling, saving)
+        click.echo("auvtrack: interrupted", err=True)
+        return EXIT_INTERRUPTED
     except (ScenarioError, ValueError, KeyError, OSError) as e:
         click.echo(f"auvtrack: error: {_one_line(e)}", err=True)
         return EXIT_BAD_INPUT

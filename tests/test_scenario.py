@@ -201,7 +201,9 @@ BAD = [
     ({"sim": {"dt": -0.001}}, "sim.dt", "must be > 0 (got -0.001)"),
     ({"sim": {"dt": 0.0}}, "sim.dt", "must be > 0"),
     ({"vehicle": {"l": 0}}, "vehicle.l", "must be > 0 (got 0)"),
-    ({"vehicle": {"m": [215, 265, -1, 80, 80]}}, "vehicle.m.2", "must be > 0"),
+    ({"vehicle": {"m": [215, 265, -1, 80, 80]}}, "vehicle.m.2", "must be >= 0.001"),
+    ({"vehicle": {"m": [215, 265, 1e-300, 80, 80]}}, "vehicle.m.2", "must be >= 0.001"),
+    ({"vehicle": {"d": [70, 1e300, 100, 50, 50]}}, "vehicle.d.1", "must be <= 1e+07"),
     ({"vehicle": {"m": [215, 265, 265, 80]}}, "vehicle.m", "must have 5 items"),
     ({"sim": {"bogus": 1}}, "sim.bogus", "unknown key (allowed: duration, dt, log_dt"),
     ({"bogus": 1}, "bogus", "unknown key (allowed: name"),
@@ -215,13 +217,22 @@ BAD = [
     ({"sim": {"duration": 0.0005}}, "sim.dt", "must be <= duration"),
     ({"sim": {"control_rate": 300}}, "sim.control_rate", "integer multiple of dt"),
     ({"vehicle": {"preset": "nautilus"}}, "vehicle.preset", "unknown preset (allowed: paper"),
-    ({"controller": {"kind": "pid"}}, "controller.kind", "unknown kind (allowed: 'fxtntsmc', 'ftsmc'"),
+    ({"controller": {"kind": "lqr"}}, "controller.kind", "unknown kind (allowed: 'fxtntsmc', 'ftsmc'"),
     ({"reference": {"kind": "spiral"}}, "reference.kind", "spiral"),
     ({"reference": {"radius": -4}}, "reference.radius", "(got -4"),
     ({"disturbance": [{"kind": "paper", "amplitude": -1}]}, "disturbance.0.amplitude", "got -1"),
     ({"disturbance": [{"amplitude": 1}]}, "disturbance.0.kind", "required"),
     ({"disturbance": {"kind": "paper"}}, "disturbance", "array of tables"),
-    ({"initial": {"eta": [0, 0, 0, 1.6, 0]}}, "initial.eta.3", "|theta| < pi/2"),
+    ({"initial": {"eta": [0, 0, 0, 1.6, 0]}}, "initial.eta.3", "must be in (-1.5708, 1.5708) rad"),
+    ({"initial": {"eta": [0, 0, 0, 1.5, 0]}}, "initial.eta.3", "must be < sim.theta_limit = 85 deg"),
+    ({"initial": {"nu": [1e300, 0, 0, 0, 0]}}, "initial.nu.0", "must be in [-100, 100] m/s (got 1e+300)"),
+    ({"initial": {"nu": [0, 0, 0, 0, -11]}}, "initial.nu.4", "must be in [-10, 10] rad/s"),
+    ({"sim": {"duration": 2, "log_dt": 5}}, "sim.log_dt", "must be <= duration = 2 s"),
+    ({"sim": {"duration": 1, "log_dt": 0.3}}, "sim.log_dt", "must divide duration = 1 s"),
+    ({"sim": {"duration": 10, "control_rate": 0.01}}, "sim.control_rate", "must be >= 1/duration = 0.1 Hz"),
+    ({"seed": 2**63}, "seed", "must be <= 9223372036854775807"),
+    ({"limits": {"max_steps": 1e9}}, "limits.max_steps", "must be an integer"),
+    ({"limits": {"max_steps": 0}}, "limits.max_steps", "must be >= 1"),
     ({"envelope": {"rho_inf": [0.005, 0.6, 0.005]}}, "envelope.rho_inf.1", "must be < rho0.1"),
     ({"envelope": {"xi0": 1.0}}, "envelope.xi0", "must be < 1"),
     ({"estimator": {"neurons": 0}}, "estimator.neurons", "must be >= 1"),
@@ -231,7 +242,11 @@ BAD = [
     ({"sim": {"theta_limit": 90}}, "sim.theta_limit", "must be < 90"),
     ({"sim": {"dt": math.nan}}, "sim.dt", "got nan"),
     ({"sim": 3}, "sim", "must be a table"),
-    ({"name": ""}, "name", "non-empty"),
+    ({"name": ""}, "name", "must be 1 to 100 characters"),
+    ({"name": "../x"}, "name", "must be 1 to 100 characters"),
+    ({"name": "a\x00b"}, "name", "must be 1 to 100 characters"),
+    ({"name": "x" * 101}, "name", "must be 1 to 100 characters"),
+    ({"name": "-rf"}, "name", "starting with a letter, digit or _"),
 ]
 
 
@@ -303,8 +318,14 @@ def test_controller_union_covers_registry():
 
     kinds = {m.model_fields["kind"].default for m in CONTROLLER_MODELS}
     assert kinds == set(CONTROLLERS)
-    for kind in kinds:
-        assert load_scenario({}, [f"controller.kind={kind}"]).controller.kind == kind
+    example = Path(__file__).resolve().parents[1] / "examples" / "plugin_controller.py"
+    needs_6dof = {"open_loop_actuators"}  # commands fins and propeller (issue 11)
+    for kind in kinds:  # a plug-in needs its module
+        extra = [f"controller.module=\"{example}\""] if kind == "plugin" else []
+        extra += ["plant.model=6dof"] if kind in needs_6dof else []
+        assert load_scenario({}, [f"controller.kind={kind}", *extra]).controller.kind == kind
+    with pytest.raises(ScenarioError, match="controller.module: required key is missing"):
+        load_scenario({}, ["controller.kind=plugin"])
 
 
 def test_frozen():

@@ -25,6 +25,7 @@ import lane_cases
 from auvtrack._lanes import as_lanes, full_mask, get_lane
 from auvtrack.control import CONTROLLERS
 from auvtrack.runner.batch import StopSignal, _run_simd, run_batch
+from auvtrack.runner.bench import builtin_controllers
 from auvtrack.scenario import load_scenario, paper_scenario_path
 from auvtrack.simulation import engine, kernels
 from auvtrack.simulation.api import prepare, run_prepared
@@ -139,7 +140,7 @@ def _states(prep, n, seed):
     return X, T, refm
 
 
-@pytest.mark.parametrize("kind", sorted(CONTROLLERS))
+@pytest.mark.parametrize("kind", builtin_controllers())
 def test_each_law_in_lane_form_equals_the_scalar_law(kind):
     from auvtrack.control.contract import WORK_SIZE
     from auvtrack.plant.kinematics import attitude
@@ -214,7 +215,7 @@ def _failing_batch(kind: str) -> list[dict]:
     return cases
 
 
-@pytest.mark.parametrize("kind", sorted(CONTROLLERS))
+@pytest.mark.parametrize("kind", builtin_controllers())
 def test_simd_batch_equals_single_runs_with_failures_at_different_times(kind):
     preps = [prepare(load_scenario(PAPER, c)) for c in _failing_batch(kind)]
     singles = [run_prepared(p) for p in preps]

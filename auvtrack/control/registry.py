@@ -42,7 +42,7 @@ class CompiledController:
     xc0 : numpy.ndarray
         Initial internal state (adaptive weights, envelope filters, integrators); may be empty.
     aux_names : tuple of str
-        Names of the extra logged channels the controller writes (``rho_x``, ``S_x``, ...).
+        Names of the extra logged channels the controller writes (``rho_x``, ``sliding_x``, ...).
     notes : tuple of str
         Warnings to show the user (e.g. an initial envelope widening).
     resolved : dict
@@ -50,6 +50,8 @@ class CompiledController:
     law : str
         Where the compiled ``control`` lives: an importable module name or a ``.py`` file path.
         Empty: the registered module's (plug-ins set it to their file).
+    statuses : dict of int to str
+        Messages of status codes beyond the registered module's ``STATUS`` (a plug-in's own).
     """
 
     cp: np.ndarray
@@ -58,6 +60,7 @@ class CompiledController:
     notes: tuple[str, ...] = ()
     resolved: dict[str, Any] = field(default_factory=dict)
     law: str = ""
+    statuses: dict[int, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -17,13 +17,13 @@ from __future__ import annotations
 import json
 import logging
 import math
-import os
 import time
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
+from .._atomic import atomic_file, atomic_write
 from .sweep_schema import StudyError, StudySpec, load_study
 
 MANIFEST = "study.json"
@@ -68,15 +68,12 @@ def chunk_path(out: Path, chunk: int) -> Path:
 def _write_atomic_table(table, path: Path) -> None:
     import pyarrow.parquet as pq
 
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    pq.write_table(table, tmp)
-    os.replace(tmp, path)
+    with atomic_file(path) as fh:  # unique, exclusively created temporary name, then rename
+        pq.write_table(table, fh)
 
 
 def _write_atomic_text(text: str, path: Path) -> None:
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    atomic_write(path, text)
 
 
 def _manifest(spec: StudySpec) -> dict:
@@ -109,13 +106,46 @@ def _prepare_out(spec: StudySpec, out: Path, resume: bool) -> set[int]:
     elif done:
         raise StudyError(f"--out: {out} holds chunk files but no {MANIFEST}; choose another folder")
     _write_atomic_text(json.dumps(_manifest(spec), indent=2), man_path)
-    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp-*"):  # left by an interrupted write
+    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp"):  # left by an interrupted write
         stale.unlink(missing_ok=True)
     return done
 
 
-def _client(workers: int | None, scheduler: str | None, memory_limit: str):
+DEFAULT_WORKER_MEMORY = "1GiB"
+
+
+def parse_memory(value: str | int) -> int:
+    """Bytes of a memory size such as ``"1GiB"``, ``"512MB"`` or an integer number of bytes.
+
+    Parameters
+    ----------
+    value : str or int
+        The size.
+
+    Returns
+    -------
+    int
+        Bytes, >= 64 MiB (a worker needs about 300 MB for Python, NumPy, Numba and the kernels).
+
+    Raises
+    ------
+    StudyError
+        One line naming ``--worker-memory`` for anything else.
+    """
+    from dask.utils import parse_bytes
+
+    try:
+        n = value if isinstance(value, int) and not isinstance(value, bool) else parse_bytes(str(value))
+    except (ValueError, TypeError):
+        raise StudyError(f"--worker-memory: must be a size such as 2GiB or 512MB (got {value!r})") from None
+    if n < 64 * 2 ** 20:
+        raise StudyError(f"--worker-memory: must be >= 64MiB (got {value!r})")
+    return int(n)
+
+
+def _client(workers: int | None, scheduler: str | None, memory_limit: str | int):
     """(client, cluster or None): a LocalCluster of ``workers`` processes or an existing scheduler."""
+    import dask
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
@@ -123,14 +153,18 @@ def _client(workers: int | None, scheduler: str | None, memory_limit: str):
     from .batch import default_workers
 
     n = default_workers() if workers is None else workers
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                           memory_limit=memory_limit, env={"NUMBA_NUM_THREADS": "1"}, silence_logs=logging.ERROR)
+    # a task whose worker dies is not retried on other workers (it would kill them too): its
+    # chunk is split into single samples instead (_compute)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               memory_limit=parse_memory(memory_limit), env={"NUMBA_NUM_THREADS": "1"},
+                               silence_logs=logging.ERROR)
     return Client(cluster), cluster
 
 
 def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False, max_chunks: int | None = None,
-              progress: bool = True, client: Any = None, memory_limit: str = "1GiB",
+              progress: bool = True, client: Any = None, memory_limit: str | int = DEFAULT_WORKER_MEMORY,
               on_chunk: Callable[[int, Any], None] | None = None) -> SweepOutcome:
     """Run (or resume) a sweep on Dask and write its results under ``out``.
 
@@ -152,8 +186,10 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
         Show a tqdm bar (samples done, rate, ETA).
     client : distributed.Client, optional
         Use this client (its cluster is left running); overrides ``workers``/``scheduler``.
-    memory_limit : str, optional
-        Per-worker memory limit of the LocalCluster.
+    memory_limit : str or int, optional
+        Per-worker memory limit of the LocalCluster (``"1GiB"``, ``"512MB"``, bytes).  A sample
+        whose tables would not fit is recorded as failed (cause ``memory``) without running; a
+        sample whose worker still dies is recorded as failed (cause ``worker_died``).
     on_chunk : callable, optional
         ``on_chunk(chunks_written_now, client)`` after each chunk file is written (a hook for
         tests and monitoring).
@@ -172,6 +208,7 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
         raise StudyError(f"--workers: must be >= 1 (got {workers})")
     if max_chunks is not None and max_chunks < 1:
         raise StudyError(f"max_chunks: must be >= 1 (got {max_chunks})")
+    parse_memory(memory_limit)
     out = Path(out)
     done = _prepare_out(spec, out, resume)
     todo = [c for c in range(spec.n_chunks) if c not in done]
@@ -219,7 +256,7 @@ def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: in
     try:
         for fut in as_completed(futures):
             c = chunk_of[fut.key]
-            table = fut.result()
+            table = _chunk_table(spec, c, fut, client, token)
             path = chunk_path(out, c)
             if not path.exists():  # idempotent: a chunk is written once
                 _write_atomic_table(table, path)
@@ -238,6 +275,40 @@ def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: in
     return written, time.perf_counter() - t0
 
 
+def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str, attempts: int = 2):
+    """The table of a finished chunk task; when its worker died, run its samples one at a time.
+
+    A worker that dies fails every task queued on it, so a sample is blamed only when it kills a
+    worker ``attempts`` times running on its own: it is then recorded as failed (cause
+    ``worker_died``), and one memory-hungry sample costs its own row, never the sweep.
+    """
+    from distributed import KilledWorker
+
+    from .sweep_worker import lost_rows, run_samples
+
+    try:
+        return fut.result()
+    except KilledWorker:
+        pass
+    import pyarrow as pa
+
+    tables = []
+    for i in spec.chunk_range(chunk):
+        for attempt in range(attempts):
+            single = client.submit(run_samples, spec, [i], key=f"auvtrack-sample-{token}-{i}-{attempt}", retries=0)
+            try:
+                tables.append(single.result())
+                break
+            except KilledWorker as exc:
+                reason = " ".join(str(exc).split())[:200]
+            finally:
+                single.release()
+        else:
+            tables.append(lost_rows(spec, [i], f"the worker process died running this sample alone, {attempts} times "
+                                               f"(out of memory? see --worker-memory): {reason}"))
+    return pa.concat_tables(tables)
+
+
 def combine(spec: StudySpec, out: Path) -> Path:
     """Stream every chunk file, in chunk order, into ``out/results.parquet`` (atomic)."""
     import pyarrow.parquet as pq
@@ -246,11 +317,9 @@ def combine(spec: StudySpec, out: Path) -> Path:
 
     schema = result_schema(spec)
     path = out / RESULTS
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    with pq.ParquetWriter(tmp, schema) as writer:
+    with atomic_file(path) as fh, pq.ParquetWriter(fh, schema) as writer:
         for c in range(spec.n_chunks):
             writer.write_table(pq.read_table(chunk_path(out, c), schema=schema))
-    os.replace(tmp, path)
     return path
 
 
@@ -269,26 +338,26 @@ def _finite_or_none(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def summarize(results: Path, spec: StudySpec) -> dict:
-    """Counts, failure rate, causes and per-metric quantiles (over "ok" samples) of a results file."""
+def group_keys(spec: StudySpec) -> list[str]:
+    """Grid keys whose values are names (``controller.kind``, ``vehicle.preset``...): one summary each.
+
+    Pooling the metrics of different controllers or vehicles gives quantiles of neither, so the
+    summary is grouped by every grid key whose values are all strings.
+    """
+    return [k for k, vals in spec.study.grid.items() if vals and all(isinstance(v, str) for v in vals)]
+
+
+def _stats(status, cause, columns: dict, mask) -> dict:
+    """Counts, causes and per-metric quantiles (over the ok samples) of the rows in ``mask``."""
     import numpy as np
-    import pyarrow.compute as pc
-    import pyarrow.parquet as pq
 
-    from ..simulation.metrics import METRIC_NAMES
-
-    status = pq.read_table(results, columns=["status", "cause"])
-    n = status.num_rows
-    counts = {k: int(v) for k, v in zip(*np.unique(status.column("status").to_numpy(zero_copy_only=False),
-                                                   return_counts=True))}
-    causes = {}
-    for k, v in zip(*np.unique(status.column("cause").to_numpy(zero_copy_only=False), return_counts=True)):
-        if k:
-            causes[str(k)] = int(v)
-    ok_mask = pc.equal(status.column("status"), "ok")
+    st, ca = status[mask], cause[mask]
+    counts = {str(k): int(v) for k, v in zip(*np.unique(st, return_counts=True))}
+    causes = {str(k): int(v) for k, v in zip(*np.unique(ca[ca != None], return_counts=True)) if k}  # noqa: E711
+    ok = st == "ok"
     metrics: dict[str, dict] = {}
-    for name in METRIC_NAMES:
-        col = pq.read_table(results, columns=[name]).column(name).filter(ok_mask).to_numpy()
+    for name, col in columns.items():
+        col = col[mask][ok]
         fin = col[np.isfinite(col)]
         entry: dict[str, Any] = {"n_finite": int(fin.size), "n_inf": int(np.isinf(col).sum())}
         if fin.size:
@@ -298,28 +367,72 @@ def summarize(results: Path, spec: StudySpec) -> dict:
                 entry[f"q{int(round(q * 100)):02d}"] = float(v)
             entry["max"] = float(fin.max())
         metrics[name] = entry
-    failed = counts.get("failed", 0)
-    invalid = counts.get("invalid", 0)
-    return {"study": spec.study.name, "source": spec.source, "samples": n, "counts": counts,
-            "failure_rate": failed / n if n else math.nan, "invalid_rate": invalid / n if n else math.nan,
-            "causes": causes, "varied": list(spec.varied), "quantile_levels": list(QUANTILES), "metrics": metrics}
+    n = int(mask.sum())
+    return {"samples": n, "counts": counts, "failure_rate": counts.get("failed", 0) / n if n else math.nan,
+            "invalid_rate": counts.get("invalid", 0) / n if n else math.nan, "causes": causes, "metrics": metrics}
+
+
+def summarize(results: Path, spec: StudySpec) -> dict:
+    """Counts, failure rate, causes and per-metric quantiles (over "ok" samples) of a results file.
+
+    The top level pools every sample; ``groups`` repeats the statistics for each combination of
+    the :func:`group_keys` values (e.g. one entry per controller), in grid order.
+    """
+    import itertools
+
+    import numpy as np
+    import pyarrow.parquet as pq
+
+    from ..simulation.metrics import METRIC_NAMES
+
+    keys = group_keys(spec)
+    table = pq.read_table(results, columns=["status", "cause", *keys, *METRIC_NAMES])
+    status = table.column("status").to_numpy(zero_copy_only=False)
+    cause = table.column("cause").to_numpy(zero_copy_only=False)
+    columns = {m: table.column(m).to_numpy() for m in METRIC_NAMES}
+    out = {"study": spec.study.name, "source": spec.source,
+           **_stats(status, cause, columns, np.ones(len(status), dtype=bool)),
+           "varied": list(spec.varied), "quantile_levels": list(QUANTILES), "group_keys": keys, "groups": []}
+    values = {k: table.column(k).to_numpy(zero_copy_only=False) for k in keys}
+    for combo in itertools.product(*(spec.study.grid[k] for k in keys)) if keys else ():
+        mask = np.logical_and.reduce([values[k] == v for k, v in zip(keys, combo)])
+        out["groups"].append({"key": dict(zip(keys, combo)), **_stats(status, cause, columns, mask)})
+    return out
 
 
 def summary_markdown(s: dict) -> str:
-    """Render a summary (from :func:`summarize`) as Markdown."""
+    """Render a summary (from :func:`summarize`) as Markdown: one quantile table per group."""
     lines = [f"# Sweep {s['study']}", "", f"Study file: `{s['source']}`; varied: "
              f"{', '.join(f'`{k}`' for k in s['varied']) or 'nothing (replicates only)'}.", "",
-             f"Samples: {s['samples']} — " + ", ".join(f"{k}: {v}" for k, v in sorted(s["counts"].items())) +
-             f"; failure rate {s['failure_rate']:.2%}" + (f", invalid {s['invalid_rate']:.2%}" if s["invalid_rate"]
-                                                          else "") + ".", ""]
+             f"Samples: {s['samples']} — " + _counts_text(s), ""]
     if s["causes"]:
         lines += ["Failure causes: " + ", ".join(f"{k} ({v})" for k, v in sorted(s["causes"].items())) + ".", ""]
     if "seconds" in s and s["seconds"]:
         lines += [f"Computed in {s['seconds']:.1f} s.", ""]
-    qs = [f"q{int(round(q * 100)):02d}" for q in s["quantile_levels"]]
-    lines += ["Metric quantiles over the ok samples (finite values; `inf` = never settled):", "",
-              "| metric | n | inf | mean | " + " | ".join(qs) + " |", "|---" * (4 + len(qs)) + "|"]
+    groups = s.get("groups") or []
+    if not groups:
+        return "\n".join(lines + _quantile_table(s, s["quantile_levels"])) + "\n"
+    lines += [f"Grouped by {', '.join(f'`{k}`' for k in s['group_keys'])}: the samples of different "
+              "groups are never pooled.", ""]
+    for g in groups:
+        name = ", ".join(f"{k} = {v}" for k, v in g["key"].items())
+        lines += [f"## {name}", "", f"Samples: {g['samples']} — " + _counts_text(g), ""]
+        if g["causes"]:
+            lines += ["Failure causes: " + ", ".join(f"{k} ({v})" for k, v in sorted(g["causes"].items())) + ".", ""]
+        lines += _quantile_table(g, s["quantile_levels"]) + [""]
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def _counts_text(s: dict) -> str:
+    return (", ".join(f"{k}: {v}" for k, v in sorted(s["counts"].items())) + f"; failure rate {s['failure_rate']:.2%}"
+            + (f", invalid {s['invalid_rate']:.2%}" if s["invalid_rate"] else "") + ".")
+
+
+def _quantile_table(s: dict, levels) -> list[str]:
+    qs = [f"q{int(round(q * 100)):02d}" for q in levels]
+    lines = ["Metric quantiles over the ok samples (finite values; `inf` = never settled):", "",
+             "| metric | n | inf | mean | " + " | ".join(qs) + " |", "|---" * (4 + len(qs)) + "|"]
     for name, e in s["metrics"].items():
         vals = [f"{e[k]:.4g}" if k in e else "–" for k in ["mean"] + qs]
         lines.append(f"| {name} | {e['n_finite']} | {e['n_inf']} | " + " | ".join(vals) + " |")
-    return "\n".join(lines) + "\n"
+    return lines

@@ -7,6 +7,8 @@ controller's set-up: everything becomes packed float64 arrays, bundled as the en
 """
 from __future__ import annotations
 
+import importlib
+
 import math
 import threading
 import time
@@ -26,7 +28,9 @@ from ..plant.kinematics import attitude, virtual_point
 from ..plant.params import ELL
 from ..plant.presets import vehicle_arrays  # noqa: F401  (re-exported: studies use it from here)
 from ..reference import build_reference
+from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
+from ..scenario.plan import plan_run
 from . import engine, kernels
 from .engine import ControllerBundle, EnvironmentBundle, Outputs, PlantBundle, Settings
 from .metrics import METRICS_SIZE, metrics_finalize, metrics_init
@@ -141,13 +145,6 @@ class Prepared:
         return self.plant.x0.size + self.controller.x0.size
 
 
-def _steps(value: float, dt: float, name: str) -> int:
-    n = round(value / dt)
-    if n < 1 or abs(n * dt - value) > 1e-9 * max(1.0, value):
-        raise ValueError(f"{name} ({value}) must be a positive integer multiple of sim.dt ({dt})")
-    return n
-
-
 def _c(a) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
@@ -170,7 +167,8 @@ def prepare(scenario: Scenario) -> Prepared:
     ------
     ValueError
         If the plant or the controller refuses the set-up (e.g. a start on the envelope with the
-        treatment off), naming the field.
+        treatment off), naming the field, or the run plan exceeds the scenario's ``[limits]``
+        (:class:`~auvtrack.scenario.ScenarioError`, :func:`auvtrack.scenario.plan.plan_run`).
     """
     sc = scenario
     plant_spec = get_plant(sc.plant.model) if hasattr(sc, "plant") else get_plant("5dof")
@@ -178,7 +176,6 @@ def prepare(scenario: Scenario) -> Prepared:
     vp_nom, _, _ = vehicle_arrays(sc)
     ref = build_reference(dict(sc.reference))
     ref_p = ref.pack()
-    tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     eta0 = np.array(sc.initial.eta, dtype=float)
     p0, v0, a0 = ref.evaluate(0.0)
     refm0 = np.vstack([p0, v0, a0])
@@ -187,10 +184,11 @@ def prepare(scenario: Scenario) -> Prepared:
                        dt=sc.sim.dt, control_rate=sc.sim.control_rate)
     cspec = get_controller(sc.controller.kind)
     cc = cspec.setup(sc, ctx)
+    channels = BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names)
+    plan = plan_run(sc, len(channels))  # every size checked against [limits] before any allocation
+    tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     dt = sc.sim.dt
-    n_steps = _steps(sc.sim.duration, dt, "sim.duration")
-    log_every = _steps(sc.sim.log_dt, dt, "sim.log_dt")
-    ctrl_every = 0 if sc.sim.control_rate == 0 else _steps(1.0 / sc.sim.control_rate, dt, "1/sim.control_rate")
+    n_steps, log_every, ctrl_every = plan.n_steps, plan.log_every, plan.control_every
     naux = len(cc.aux_names)
     si = np.array([n_steps, log_every, ctrl_every, naux], dtype=np.int64)
     t0, t1 = sc.metrics.window
@@ -201,20 +199,21 @@ def prepare(scenario: Scenario) -> Prepared:
     sigma = (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu)
     if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
-    noise = noise_table(sc.seed, n_steps // ctrl_every + 1 if ctrl_every else 1, sigma)
-    key = kernels.KernelKey(cc.law or cspec.module, plant_spec.module, f"{cspec.name} on {plant_spec.name}")
+    noise = noise_table(sc.seed, plan.control_samples if ctrl_every else 1, sigma)
+    key = kernels.KernelKey(cc.law or cspec.module, cpl.module or plant_spec.module,
+                            f"{cspec.name} on {plant_spec.name}")
     return Prepared(
         scenario=sc, key=key,
         plant=PlantBundle(_c(cpl.pp), _c(cpl.x0)),
         controller=ControllerBundle(_c(cc.cp), _c(cc.xc0), _c(vp_nom)),
         environment=EnvironmentBundle(_c(tables.rows), _c(tables.current), _c(noise)),
         ref_p=_c(ref_p), settings=Settings(si, sf),
-        n_rows=n_steps // log_every + 1,
-        channels=BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names),
-        notes=tuple(cpl.notes) + tuple(cc.notes),
+        n_rows=plan.log_rows,
+        channels=channels,
+        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[ELL])] if n),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": cc.resolved},
-        statuses={**CONTROLLER_STATUS, **cspec.statuses},
+        statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
     )
 
 
@@ -261,21 +260,28 @@ def call_kernel(prep: Prepared, out: Outputs) -> tuple[int, int, float]:
 
 
 def _in_worker_thread(fn, stop: np.ndarray):
-    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag."""
+    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag.
+
+    The wait is on an Event, not on ``Thread.join``: a ``join`` interrupted by Ctrl-C can report
+    the thread finished while it still runs (CPython 3.11), and the result would be lost.
+    """
     box: dict[str, Any] = {}
+    done = threading.Event()
 
     def target():
         try:
             box["value"] = fn()
         except BaseException as exc:  # pragma: no cover - re-raised below
             box["error"] = exc
+        finally:
+            done.set()
 
     th = threading.Thread(target=target, name="auvtrack-run", daemon=True)
     th.start()
     interrupted = False
-    while th.is_alive():
+    while not done.is_set():
         try:
-            th.join(0.05)
+            done.wait(0.05)
         except KeyboardInterrupt:
             stop[engine.INFO_STOP] = 1
             interrupted = True
@@ -370,7 +376,10 @@ def failure_record(cause: int, t: float, fail_state: np.ndarray, prep: Prepared)
 
 def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
     nxp = prep.plant.x0.size
-    st: dict[str, Any] = {n: float(state[i]) for i, n in enumerate(STATE_NAMES)}
+    # the 5-DOF names label the plant's pose (a 6-DOF state has roll at index 3)
+    pose = importlib.import_module(prep.key.plant).pose
+    eta, nu = pose(np.ascontiguousarray(state[:nxp], dtype=np.float64))
+    st: dict[str, Any] = {n: float(v) for n, v in zip(STATE_NAMES, (*eta, *nu))}
     if nxp > len(STATE_NAMES):
         st["plant_state"] = [float(x) for x in state[:nxp]]
     if state.size > nxp:
