@@ -101,3 +101,19 @@ def test_bench_all_leaves_the_working_tree_unchanged(tmp_path):
     assert {"single", "batch", "sweep"} <= set(doc) and (folder / "results.md").exists()
     assert f"written: {folder / 'results.json'}" in p.stdout
     assert "Traceback" not in p.stderr and "heartbeat" not in p.stderr, p.stderr[-3000:]
+
+
+def test_warmup_covers_every_builtin_controller_on_every_plant_it_runs_on():
+    """Warmup's default pairs: each built-in controller (the 6-DOF-only one on the 6-DOF plant only) on
+    every plant, which warmup expands to one kernel per preset module."""
+    from auvtrack.control import BUILTIN_NAMES
+    from auvtrack.plant import PLANTS
+    from auvtrack.runner.bench import SIXDOF_ONLY, builtin_pairs
+
+    pairs = builtin_pairs()
+    assert {c for c, _ in pairs} == set(BUILTIN_NAMES)
+    for c in BUILTIN_NAMES:
+        plants = {p for k, p in pairs if k == c}
+        assert plants == ({"6dof"} if c in SIXDOF_ONLY else set(PLANTS))
+    assert len(PLANTS["6dof"].kernel_modules) >= 2  # the preset modules: one kernel each
+    assert builtin_pairs(("ftsmc",), ("5dof",)) == [("ftsmc", "5dof")]

@@ -23,7 +23,6 @@ from hypothesis import strategies as st
 
 import lane_cases
 from auvtrack._lanes import as_lanes, full_mask, get_lane
-from auvtrack.control import CONTROLLERS
 from auvtrack.runner.batch import StopSignal, _run_simd, run_batch
 from auvtrack.runner.bench import builtin_controllers
 from auvtrack.scenario import load_scenario, paper_scenario_path
@@ -226,6 +225,32 @@ def test_simd_batch_equals_single_runs_with_failures_at_different_times(kind):
         times = {r.failure["time"] for r in singles if r.failure}
         assert len(times) >= 2, "the batch should have lanes failing at different times"
         assert {r.status for r in singles} == {"ok", "failed"}
+
+
+def test_simd_batch_on_the_6dof_plants_equals_single_runs():
+    """Both 6-DOF preset modules (Prestero, Fossen) in lanes: a tracking law with noise, sampled-data
+    control and a current, roll limits that stop lanes at different times, and the open-loop actuator
+    controller (fin and propeller commands) of different lengths; one call, input order."""
+    from pathlib import Path
+
+    remus = Path(__file__).resolve().parents[1] / "scenarios" / "remus100.toml"
+    limits = [5.0, 9.0, 10.0, 11.0, 180.0]
+    track = [{"plant.model": "6dof", "plant.preset": "remus100_prestero", "controller.kind": "fxtntsmc",
+              "sim.duration": 0.5 if i % 2 else 0.4, "initial.nu": [1.0, 0.0, 0.0, 0.0, 0.0], "seed": i,
+              "initial.phi": 0.15, "sim.phi_limit": limits[i % len(limits)], "sim.control_rate": 100,
+              "sensor.sigma_eta": [0.01, 0.01, 0.01, 0.003, 0.003],
+              "disturbance": [{"kind": "current", "mean": [0.2, 0.1, 0.0], "sigma": [0.02, 0.02, 0.0]}]}
+             for i in range(L + 3)]
+    actuate = [{"plant.model": "6dof", "plant.preset": "remus100_fossen", "controller.kind": "open_loop_actuators",
+                "controller.delta_r": 0.02 * (i % 5), "sim.duration": 0.3 + 0.05 * (i % 3)} for i in range(L)]
+    cases = [c for pair in zip(track, actuate) for c in pair] + track[L:]
+    preps = [prepare(load_scenario(remus, c)) for c in cases]
+    singles = [run_prepared(p) for p in preps]
+    for s, r in zip(run_batch(preps, backend="simd", workers=2), singles):
+        _same_run(s, r, bitwise=True)
+    track_runs = [r for r, c in zip(singles, cases) if c["controller.kind"] == "fxtntsmc"]
+    assert {r.status for r in track_runs} == {"ok", "failed"}
+    assert len({r.failure["time"] for r in track_runs if r.failure}) >= 2, "lanes should fail at different times"
 
 
 def test_simd_mixed_batch_in_input_order():

@@ -345,8 +345,10 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     workers : int, optional
         Threads (``"threads"`` back end); default :func:`default_workers`.  The ``"prange"``
         back end uses Numba's thread count (``NUMBA_NUM_THREADS``).
-    backend : {"threads", "prange", "serial"}
-        How runs are spread over cores (``trajectories`` always uses threads).
+    backend : {"threads", "prange", "serial", "simd"}
+        How runs are spread over cores (``trajectories`` always uses threads); ``"simd"`` runs
+        groups of equal kernel and shapes in the lanes of a SIMD register, falling back to the
+        thread back end (with a warning) for a law or plant without a lane form.
 
     Returns
     -------

@@ -44,6 +44,29 @@ def builtin_controllers() -> tuple[str, ...]:
     return tuple(n for n in BUILTIN_NAMES if n != "open_loop_actuators")
 
 
+SIXDOF_ONLY: tuple[str, ...] = ("open_loop_actuators",)
+"""Built-in controllers that only run on a 6-DOF plant (fin and propeller commands)."""
+
+
+def builtin_pairs(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = ()) -> list[tuple[str, str]]:
+    """(controller, plant) pairs a run can use: every built-in controller on every plant it runs on.
+
+    Parameters
+    ----------
+    controllers, plants : tuple of str, optional
+        Registered names (default: every built-in controller, :data:`SIXDOF_ONLY` included, and every plant).
+
+    Returns
+    -------
+    list of (str, str)
+        The pairs, controllers in registry order; a :data:`SIXDOF_ONLY` controller only with ``"6dof"``.
+    """
+    from ..plant import PLANTS
+
+    cs = controllers or builtin_controllers() + SIXDOF_ONLY
+    return [(c, p) for c in cs for p in (plants or tuple(PLANTS)) if c not in SIXDOF_ONLY or p == "6dof"]
+
+
 def plugin_copy(kind: str, folder: Path) -> Path:
     """Write built-in controller ``kind``'s module as a stand-alone plug-in file (absolute imports).
 
@@ -167,7 +190,8 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     Parameters
     ----------
     controllers, plants : tuple of str, optional
-        Registered names (default: all).
+        Registered names (default: every built-in controller on every plant it runs on,
+        :func:`builtin_pairs`; a 6-DOF plant's kernels one per preset module).
     progress : bool, optional
         Show a progress bar while compiling.
 
@@ -181,8 +205,7 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     from ..simulation import kernels
 
     keys = [kernels.KernelKey(CONTROLLERS[c].module, module, f"{c} on {label}")
-            for c in (controllers or builtin_controllers()) for p in (plants or tuple(PLANTS))
-            for label, module in PLANTS[p].kernel_modules.items()]
+            for c, p in builtin_pairs(controllers, plants) for label, module in PLANTS[p].kernel_modules.items()]
     t0 = time.perf_counter()
     done = kernels.warmup(keys, progress=progress)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
@@ -265,4 +288,4 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
 
 
 __all__ = ["bench_single", "bench_singles", "bench_all", "user_bench_folder", "warmup", "machine",
-           "builtin_controllers", "plugin_copy"]
+           "builtin_controllers", "builtin_pairs", "SIXDOF_ONLY", "plugin_copy"]
