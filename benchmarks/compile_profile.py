@@ -87,7 +87,9 @@ if lanes:  # the SIMD batch kernel (its scalar kernel first, not counted)
     from auvtrack.runner.batch import run_batch
     from auvtrack.scenario import load_scenario, paper_scenario_path
     from auvtrack.simulation.api import prepare
-    preps = [prepare(load_scenario(paper_scenario_path(), {"controller.kind": c, "sim.duration": 0.01}))]
+    from auvtrack.simulation.engine import LANES
+    preps = [prepare(load_scenario(paper_scenario_path(), {"controller.kind": c, "sim.duration": 0.01, "seed": i}))
+             for i in range(LANES)]  # one full block: fewer runs would go to the single-run kernel
     run_batch(preps, backend="serial")
     for d in (excl, count, fn_excl, fn_llvm, compiles):
         d.clear()

@@ -213,7 +213,7 @@ def bench_cold_start(*, duration: float = 1.0) -> dict:
 
 
 def bench_cold_warmup() -> dict:
-    """Wall time of ``auvtrack warmup`` (every registered controller on every plant) with an empty cache."""
+    """Wall time of ``auvtrack warmup`` (every built-in controller on every plant it runs on) with an empty cache."""
     import subprocess
     import sys
 
@@ -279,7 +279,8 @@ def write_results(doc: dict, out: Path) -> None:
                   f"| `auvtrack run` Section 4 ({c['run_seconds']:g} s), compiling {', '.join(c['kernels_compiled'])} "
                   f"({c['compile_seconds']:.1f} s of it) | {c['seconds']:.1f} | {c['load_avg_1min']} |"]
         if w:
-            lines += [f"| `auvtrack warmup`: {w['kernels']} kernels (every registered controller on every plant) | "
+            lines += [f"| `auvtrack warmup`: {w['kernels']} kernels (every built-in controller on every plant it runs "
+                      "on, one per 6-DOF preset module) | "
                       f"{w['seconds']:.1f} | {w['load_avg_1min']} |"]
         lines += [""]
     lines += ["## Batch runner (metrics only, 10 s runs at dt = 1 ms)", "",

@@ -123,7 +123,7 @@ KERNEL_PARTS: dict[str, str] = {}
 LANE_PARTS: dict[str, str] = {}
 """The same for the parts of the SIMD batch module of a pair (:func:`run_lanes`)."""
 LANES = 8
-"""Runs per SIMD register in the lane kernels: float64 lanes of one 256-bit AVX2 register."""
+"""Runs per block of the lane kernels: the float64 lanes of one 512-bit AVX-512 register (two AVX2 registers)."""
 
 
 def kernel_part(decorator: str, *, lanes: bool = False):
