@@ -200,12 +200,10 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     dict
         ``{"kernels": [...], "compiled": [...], "seconds": wall time}``.
     """
-    from ..control import CONTROLLERS
-    from ..plant import PLANTS
     from ..simulation import kernels
+    from ..simulation.api import kernel_keys
 
-    keys = [kernels.KernelKey(CONTROLLERS[c].module, module, f"{c} on {label}")
-            for c, p in builtin_pairs(controllers, plants) for label, module in PLANTS[p].kernel_modules.items()]
+    keys = kernel_keys(builtin_pairs(controllers, plants))
     t0 = time.perf_counter()
     done = kernels.warmup(keys, progress=progress)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
