@@ -207,3 +207,25 @@ def test_findings_md_does_not_link_the_merged_draft():
     assert not (findings.ROOT / "docs" / "findings_model_gap.md").exists()
     for path in [findings.ROOT / "README.md", *sorted((findings.ROOT / "docs").glob("*.md"))]:
         assert "findings_model_gap" not in path.read_text(), path.name
+
+
+def test_performance_block_verdicts_follow_the_record():
+    """README's performance verdicts are computed from the bench record, not typed: changing a
+    number across its target flips the verdict."""
+    import copy
+    import json
+
+    from auvtrack.studies import findings
+
+    rec = json.loads(findings.BENCH.read_text())
+    text = findings.block_performance(rec)
+    assert f"{rec['cold']['seconds']:.1f} s" in text
+    slow = copy.deepcopy(rec)
+    for r in slow["single"]:
+        if r["controller"] == "fxtntsmc":
+            r["cpu_us_per_step"] = 2.5
+    fast = copy.deepcopy(rec)
+    fast["cold"]["seconds"], fast["cold_warmup"]["seconds"] = 10.0, 60.0
+    assert "FXTNTSMC ≤ 2.0 | not met" in findings.block_performance(slow)
+    assert "≤ 20 s on a quiet machine | met at that load" in findings.block_performance(fast)
+    assert "≤ 90 s | met at that load" in findings.block_performance(fast)

@@ -605,6 +605,48 @@ def block_readme(rp: dict, ab: dict, ft: dict, rl: dict, mg: dict | None = None)
     return "\n".join(lines)
 
 
+BENCH = ROOT / "benchmarks" / "results.json"
+
+
+def _met(ok: bool) -> str:
+    return "met" if ok else "not met"
+
+
+def block_performance(b: dict) -> str:
+    """README's performance table from the record of ``auvtrack bench --all --out benchmarks``."""
+    from ..runner.sweep_bench import batch_cpu_efficiency
+
+    single = {r["controller"]: r for r in b["single"]}
+    batch = {(r["controller"], r["backend"]): r for r in b["batch"]}
+    ft, fx = single["ftsmc"], single["fxtntsmc"]
+    eff = {k: batch_cpu_efficiency(batch[(k, "simd")], single[k]["cpu_us_per_step"]) for k in ("ftsmc", "fxtntsmc")}
+    m = b["machine"]
+    cold, warm = b["cold"], b["cold_warmup"]
+    sweep = {r["workers"]: r for r in b["sweep"]}
+    rows = [
+        "| | FTSMC | FXTNTSMC | target (issue) | in this record |",
+        "|---|---|---|---|---|",
+        f"| CPU µs per RK4 step, single 20 s Section 4 run, one core (wall median) | {ft['cpu_us_per_step']:.2f} "
+        f"({ft['us_per_step']:.2f}) | {fx['cpu_us_per_step']:.2f} ({fx['us_per_step']:.2f}) | FTSMC ~1.0, FXTNTSMC ≤ 2.0 "
+        f"| {_met(fx['cpu_us_per_step'] <= 2.0)} (CPU time) |",
+        *(f"| batch runs / s, 10 s runs, 2 cores, `{be}` back end | {batch[('ftsmc', be)]['runs_per_s']:.0f} | "
+          f"{batch[('fxtntsmc', be)]['runs_per_s']:.0f} | | |" for be in ("threads", "simd")),
+        f"| batch CPU efficiency of the `simd` back end | {eff['ftsmc']:.2f} | {eff['fxtntsmc']:.2f} | FXTNTSMC ≥ 2.5 | "
+        f"{_met(eff['fxtntsmc'] >= 2.5)} |",
+        f"| cold first run (`auvtrack run`, 1 s, empty cache) | | {cold['seconds']:.1f} s, {cold['compile_seconds']:.1f} s "
+        f"of it compiling (load {cold['load_avg_1min']}) | ≤ 20 s on a quiet machine | "
+        f"{_met(cold['seconds'] <= 20)} at that load |",
+        f"| cold `auvtrack warmup` ({warm['kernels']} kernels) | | {warm['seconds']:.0f} s (load {warm['load_avg_1min']}) "
+        f"| ≤ 90 s | {_met(warm['seconds'] <= 90)} at that load |",
+        f"| Dask sweep, 1 → 2 workers, samples / s | {sweep[1]['samples_per_s']:.0f} → {sweep[2]['samples_per_s']:.0f} "
+        f"(parallel efficiency {sweep[2]['parallel_efficiency']:.2f}) | | | |",
+    ]
+    head = (f"Recorded {b['date']} by `auvtrack bench --all --out benchmarks` on {m['cpu']}, {m['cores']} cores, "
+            f"vector math {m['vector_math']}, load average at the start {m['load_avg_1_5_15'][0]} "
+            f"(a shared machine: medians; CPU time is less disturbed than wall time).")
+    return head + "\n\n" + "\n".join(rows)
+
+
 # ------------------------------------------------------------------ rendering
 def blocks() -> dict[str, tuple[str, Callable[[], str]]]:
     """Generated block name -> (document key, renderer)."""
@@ -620,6 +662,7 @@ def blocks() -> dict[str, tuple[str, Callable[[], str]]]:
         "remus-u0": ("findings", lambda: block_remus_u0(load("robustness"), load("realism"))),
         "model-gap": ("findings", lambda: block_model_gap(load("model-gap"))),
         "provenance": ("findings", lambda: block_provenance(list(SOURCES))),
+        "readme-performance": ("readme", lambda: block_performance(json.loads(BENCH.read_text()))),
         "readme-reproduction": ("readme", lambda: block_readme(load("reproduce"), load("ablation"),
                                                                load("fixed-time"), load("realism"),
                                                                load("model-gap"))),
