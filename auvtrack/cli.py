@@ -1,11 +1,13 @@
-"""Command line: ``auvtrack run | check | bounds | bench | warmup | reproduce | study | sweep | compare``.
+"""Command line: ``auvtrack reproduce | run | check | bounds | study | sweep | compare | bench | warmup``.
 
 Bad input (a scenario error, a missing file, an invalid gain) prints ONE line to stderr and
 exits with status 2, never a traceback.  A simulation that fails (divergence, pitch limit,
 envelope violation) keeps and saves its partial result, prints the diagnostic and exits 3.
+Ctrl-C exits 130.  ``auvtrack --help`` lists every command and these exit codes.
 """
 from __future__ import annotations
 
+import inspect
 import json
 import sys
 import warnings
@@ -36,10 +38,47 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split()) or type(exc).__name__
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+EXIT_CODES = (("0", "success"),
+              ("2", "bad input: one line naming the field and the allowed range, no traceback"),
+              ("3", "a simulation failed (diverged, pitch limit, envelope violated): the diagnostic is printed "
+                    "and the partial result kept"),
+              ("130", "interrupted (Ctrl-C)"))
+COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "study", "sweep", "compare", "bench", "warmup")
+
+
+def _first_paragraph(text: str | None) -> str:
+    return " ".join(inspect.cleandoc(text or "").split("\n\n")[0].split())
+
+
+class _Group(click.Group):
+    """Top-level group: every command with its whole first help paragraph, then the exit codes."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        names = super().list_commands(ctx)
+        return [n for n in COMMAND_ORDER if n in names] + [n for n in names if n not in COMMAND_ORDER]
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(n, _first_paragraph(c.help)) for n in self.list_commands(ctx)
+                if (c := self.get_command(ctx, n)) is not None and not c.hidden]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+    def format_epilog(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        with formatter.section("Exit status"):
+            formatter.write_dl(list(EXIT_CODES))
+        super().format_epilog(ctx, formatter)
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="auvtrack")
 def cli() -> None:
-    """auvtrack: trajectory-tracking control of underactuated AUVs."""
+    """auvtrack: trajectory-tracking control of underactuated AUVs.
+
+    Scenarios are TOML files in which every key has a default (docs/scenarios.md); an empty
+    file is the paper's Section 4.  Start with `auvtrack reproduce`.  The first command after
+    installing or editing the package compiles the Numba kernels (about a minute, more on a
+    loaded machine; cached on disk afterwards); `auvtrack warmup` does that up front.
+    """
 
 
 set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
@@ -48,19 +87,26 @@ set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALU
 
 @cli.command()
 @click.argument("scenario")
-@click.option("--out", type=click.Path(file_okay=False), default=None, help="Run folder (default runs/<name>).")
+@click.option("--out", type=click.Path(file_okay=False), default=None,
+              help="Run folder, overwritten if it exists (default: a new runs/<name>-<controller>, "
+                   "numbered -2, -3, ... when taken).")
 @set_option
 @click.option("--mat", is_flag=True, help="Also write trajectory.mat (MATLAB).")
 def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -> None:
-    """Simulate SCENARIO (a TOML file) and write trajectory.csv and run.json."""
+    """Simulate SCENARIO (a TOML file) and write trajectory.csv and run.json to a run folder.
+
+    Without --out every run gets a new folder runs/<name>-<controller> (then -2, -3, ...), so a
+    second run never overwrites the first; the folder is printed.
+    """
     from .simulation.api import prepare, run_prepared
+    from .simulation.run_folder import default_run_folder
 
     sc = _load(scenario, overrides)
     prep = prepare(sc)
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
     res = run_prepared(prep)
-    folder = res.save(Path(out) if out else Path("runs") / sc.name, mat=mat or sc.output.mat)
+    folder = res.save(Path(out) if out else default_run_folder(sc.name, sc.controller.kind), mat=mat or sc.output.mat)
     click.echo(f"{res!r}\nwritten: {folder}")
     if not res.ok:
         f = res.failure
@@ -73,7 +119,7 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
 @click.argument("scenario")
 @set_option
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
-    """Validate SCENARIO without running it."""
+    """Validate SCENARIO and its --set overrides without simulating (warns where Theorem 1's conditions fail)."""
     sc = _load(scenario, overrides)
     if sc.controller.kind == "fxtntsmc":
         from .control.theory import check_theorem1
@@ -92,7 +138,7 @@ def check(scenario: str, overrides: tuple[str, ...]) -> None:
 @click.option("--g2", default=0.5, show_default=True, help="Tuning constant of eq. (50) in (0, 1).")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of text.")
 def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, g2: float, as_json: bool) -> None:
-    """Print Theorem 1's fixed-time bounds for the gains of SCENARIO."""
+    """Print Theorem 1's fixed-time bounds for the FXTNTSMC gains of SCENARIO, and whether they are vacuous."""
     from .control.theory import fixed_time_bounds
 
     sc = _load(scenario, overrides)
@@ -108,18 +154,25 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 @click.option("--duration", default=20.0, show_default=True, help="Simulated seconds per repetition.")
 @click.option("--all", "run_all", is_flag=True,
               help="Full suite: every controller, batch runs/s, sweep throughput on 1 and 2 Dask workers; "
-                   "writes benchmarks/results.{json,md} (or --out).")
+                   "writes results.{json,md} to --out.")
 @click.option("--out", "bench_out", type=click.Path(file_okay=False), default=None,
-              help="Folder for the --all results (default: benchmarks/ of the source tree, else .).")
+              help="Folder for the --all results (default: a new folder under ~/.local/share/auvtrack/bench, "
+                   "or $XDG_DATA_HOME; never the source tree unless asked, e.g. --out benchmarks).")
 def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
-    """Time the compiled closed loop; one JSON line per controller with us_per_step."""
+    """Time the compiled closed loop: µs per RK4 step, one JSON line per controller.
+
+    --all runs the full suite (batch runs/s, Dask sweep throughput) and writes results.json and
+    results.md to --out (default: a new user folder; the working tree is left unchanged).
+    """
     from .runner.bench import bench_single
 
     if run_all:
         from .runner.bench import bench_all
 
         doc = bench_all(repeat=repeat, out=Path(bench_out) if bench_out else None, progress=True)
+        folder = doc.pop("out")
         click.echo(json.dumps(doc, indent=2))
+        click.echo(f"written: {folder / 'results.json'}, {folder / 'results.md'}")
         return
     for kind in controllers or ("ftsmc", "fxtntsmc"):
         click.echo(json.dumps(bench_single(kind, repeat=repeat, duration=duration)))
@@ -129,7 +182,11 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
 @click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: every one).")
 @click.option("--plant", "plants", multiple=True, help="Plant model(s) (default: every one).")
 def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
-    """Compile every kernel (each controller on each plant) once, in parallel; later runs load them."""
+    """Compile every kernel (each controller on each plant) once, in parallel; later runs load them.
+
+    The first command after installing or editing the package compiles the kernels it needs
+    (about a minute, more on a loaded machine); warmup does it for every command up front.
+    """
     from .runner.bench import warmup as _warmup
 
     click.echo(json.dumps(_warmup(controllers, plants, progress=True)))
@@ -145,7 +202,10 @@ def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def sweep(study: str, out: str | None, workers: int | None, scheduler: str | None, resume: bool,
           max_chunks: int | None, quiet: bool) -> None:
-    """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask."""
+    """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask: Parquet rows, quantiles, --resume.
+
+    The study format is docs/sweeps.md; scenarios/sweep_example.toml is an example.
+    """
     from .runner.sweep import run_sweep
     from .runner.sweep_schema import load_study
 
@@ -235,14 +295,20 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
 
 
 @cli.command()
-@click.option("--out", type=click.Path(file_okay=False), default="reproduce", show_default=True)
+@click.option("--out", type=click.Path(file_okay=False), default="reproduce", show_default=True,
+              help="Output folder (overwritten).")
 @click.option("--quick", is_flag=True, help="Short horizon (smoke test).")
 def reproduce(out: str, quick: bool) -> None:
-    """Reproduce the paper's Section 4: both controllers, Figures 3-8, metrics and verdicts."""
+    """Reproduce the paper's Section 4: both controllers, Figures 3-8, metrics and a verdict on each claim.
+
+    Writes the run folders, figures/, metrics.json, summary.md and report.html (one
+    self-contained page with every figure) to --out.
+    """
     from .studies.reproduce import reproduce as _reproduce
 
     summary = _reproduce(Path(out), quick=quick, progress=True)
     click.echo(summary)
+    click.echo(f"written: {Path(out) / 'summary.md'}, {Path(out) / 'report.html'}")
 
 
 class _StudyCommand(click.Command):
@@ -261,7 +327,7 @@ class _StudyCommand(click.Command):
 @click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default studies/<NAME>).")
 @click.option("--quick", is_flag=True, help="CI-sized run (seconds instead of minutes).")
 def study(name: str, out: str | None, quick: bool) -> None:
-    """Run study NAME and write its report.md, results.json and figures (NAME 'list': list studies)."""
+    """Run study NAME and write report.md, report.html, results.json and figures/ (NAME 'list': list them)."""
     from .studies.registry import all_studies, get_study
 
     if name == "list":
@@ -273,7 +339,8 @@ def study(name: str, out: str | None, quick: bool) -> None:
     except KeyError as e:
         raise BadInput(str(e.args[0])) from None
     report = spec.run(Path(out) if out else Path("studies") / name, quick=quick, progress=True)
-    click.echo(f"report: {report}")
+    html = report.with_suffix(".html")
+    click.echo(f"report: {report}" + (f", {html}" if html.exists() else ""))
 
 
 def main(argv: list[str] | None = None) -> int:

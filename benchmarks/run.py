@@ -1,6 +1,6 @@
 """Run the full benchmark suite and write benchmarks/results.{json,md}.
 
-Usage: ``python benchmarks/run.py [--repeat 7]`` (the same as ``auvtrack bench --all``).  Reports
+Usage: ``python benchmarks/run.py [--repeat 7]`` (the same as ``auvtrack bench --all --out benchmarks``).  Reports
 medians (this machine is shared and noisy) and ratios; never used as a timed unit test.
 """
 from __future__ import annotations

@@ -55,3 +55,30 @@ def test_batch_rows_cover_every_controller_and_back_end():
         (k, b) for k in ("ftsmc", "fxtntsmc") for b in ("serial", "threads", "prange")]
     for r in rows:
         assert r["runs"] == 3 and r["repeat"] == 2 and 0 < r["runs_per_s"] <= r["max_runs_per_s"]
+
+
+def test_bench_all_leaves_the_working_tree_unchanged(tmp_path):
+    """`auvtrack bench --all` run from a clone writes to a user folder, and its Dask shutdown is quiet."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    skip = {".git", "__pycache__", ".pytest_cache", ".hypothesis"}
+
+    def snapshot():
+        return {p.relative_to(root).as_posix(): (p.stat().st_size, p.stat().st_mtime_ns)
+                for p in root.rglob("*") if p.is_file() and not skip & set(p.relative_to(root).parts)}
+
+    before = snapshot()
+    env = {**os.environ, "XDG_DATA_HOME": str(tmp_path / "data"), "PYTHONPATH": str(root)}
+    p = subprocess.run([sys.executable, "-m", "auvtrack.cli", "bench", "--all", "--repeat", "1"], cwd=root, env=env,
+                       capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert snapshot() == before  # nothing written, created or touched in the repository
+    (folder,) = (tmp_path / "data" / "auvtrack" / "bench").iterdir()
+    doc = json.loads((folder / "results.json").read_text())
+    assert {"single", "batch", "sweep"} <= set(doc) and (folder / "results.md").exists()
+    assert f"written: {folder / 'results.json'}" in p.stdout
+    assert "Traceback" not in p.stderr and "heartbeat" not in p.stderr, p.stderr[-3000:]

@@ -86,6 +86,11 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
     for name in ("fig3_trajectory3d", "fig4_positions", "fig5_velocities", "fig6_inputs", "fig7_errors", "fig8_chi"):
         assert (tmp_path / "figures" / f"{name}.png").stat().st_size > 10_000
         assert (tmp_path / "figures" / f"{name}.pdf").exists()
+    from report_check import check_html_report
+
+    html = check_html_report(tmp_path, "summary.md")  # every figure embedded, the same report as summary.md
+    assert html.count('class="verdict ') == 6 and "virtual point" in html  # 3 claims x (paper, tuned gains)
+    assert summary in (tmp_path / "summary.md").read_text()
     m = json.loads((tmp_path / "metrics.json").read_text())
     assert m["status"] == {"FXTNTSMC": "ok", "FTSMC": "ok"}
     assert {v["verdict"] for v in m["verdicts"]} <= {"supported", "not supported", "mixed"}

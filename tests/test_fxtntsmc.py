@@ -33,7 +33,7 @@ def _reaching_law_residual(res, gains=(0.005, 0.8, 0.6)):
     h = res.t[1] - res.t[0]
     worst, used = 0.0, 0
     for a in "xyz":
-        S, z, g = res[f"S_{a}"], res[f"z_{a}"], res[f"g_{a}"]
+        S, z, g = res[f"sliding_{a}"], res[f"zeta_{a}"], res[f"g_{a}"]
         se = np.array([surface(v, 0.8, 0.8, 0.8, 2.0, False, 0.01, 1e-6)[0] for v in z])
         law = -k1 * np.sign(S) - k2 * S**3 - k3 * S
         ok = np.ones(len(S) - 2, bool)

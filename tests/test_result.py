@@ -14,7 +14,7 @@ from auvtrack.simulation.metrics import METRIC_NAMES, metrics_from_trajectory
 from auvtrack.simulation.plotting import KINDS, plot_runs, save_figure
 from auvtrack.simulation.result import BASE_CHANNELS, Result, restore_nonfinite, to_jsonable
 
-EXTRA = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "S") for a in "xyz") + ("chi_x", "chi_y", "chi_z")
+EXTRA = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding") for a in "xyz") + ("chi_x", "chi_y", "chi_z")
 
 
 def make_result(n=401, dt=0.05, extras=True, status="ok", kind="fxtntsmc", seed=0):
@@ -38,7 +38,7 @@ def make_result(n=401, dt=0.05, extras=True, status="ok", kind="fxtntsmc", seed=
         for a in "xyz":
             ch[f"chi_hat_{a}"] = np.cos(t) * (1 - np.exp(-t))
         for a in "xyz":
-            ch[f"S_{a}"] = np.exp(-t)
+            ch[f"sliding_{a}"] = np.exp(-t)
         for a in "xyz":
             ch[f"chi_{a}"] = np.cos(t)
     e = np.column_stack([ch["ex"], ch["ey"], ch["ez"]])
@@ -113,9 +113,13 @@ def test_constructor_validation():
 
 def test_to_pandas():
     res = make_result()
-    df = res.to_pandas()
+    df = res.to_pandas(legacy_names=False)
     assert list(df.columns) == list(res.names)
     assert df.shape == (len(res), len(res.names))
+    # for one release the renamed channels also appear under their old names, after every channel
+    legacy = res.to_pandas()
+    assert list(legacy.columns) == list(res.names) + ["S_x", "S_y", "S_z"]
+    np.testing.assert_array_equal(legacy["S_y"].to_numpy(), res["sliding_y"])
     np.testing.assert_array_equal(df["ex"].to_numpy(), res["ex"])
     df.loc[0, "x"] = 123.0  # the frame is a copy
     assert res["x"][0] != 123.0
@@ -239,7 +243,7 @@ def test_json_helpers():
 
 
 # ------------------------------------------------------------------ plots
-N_AXES = {"trajectory3d": 1, "positions": 3, "velocities": 5, "inputs": 3, "errors": 3, "chi": 3, "overview": 10}
+N_AXES = {"trajectory3d": 1, "positions": 3, "velocities": 5, "inputs": 6, "errors": 8, "chi": 3, "overview": 10}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -260,16 +264,20 @@ def test_plot_labels_and_envelopes():
     assert ax.get_ylabel() == "$e_x$ (m)" and fig.axes[-1].get_xlabel() == "t (s)"
     styles = [line.get_linestyle() for line in ax.get_lines()]
     assert styles.count("-.") == 2 and styles.count("--") == 2  # ±rho and ±rho1
-    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "fxtntsmc" in labels and any("baseline" in lab for lab in labels)
-    assert len(res.plot("positions").axes[0].get_lines()) == 2  # run + reference
-    assert res.plot("positions", label="mine").axes[0].get_legend().get_texts()[0].get_text() == "mine"
+    assert len(res.plot("positions").axes[0].get_lines()) == 3  # reference, virtual point, CG
+    assert len(res.plot("positions", cg=False).axes[0].get_lines()) == 2
+    texts = [t.get_text() for t in res.plot("positions", label="mine").legends[0].get_texts()]
+    assert texts[0].startswith("reference") and texts[1].startswith("mine: virtual point")
+    assert len(res.plot("inputs", steady_from=None).axes) == 3
+    assert len(res.plot("errors", envelopes=False).axes) == 3
 
 
 def test_comparison_and_save_figure(tmp_path):
     runs = [("FXTNTSMC", make_result()), ("FTSMC", make_result(extras=False, kind="ftsmc", seed=1))]
     fig = plot_runs("positions", runs)
-    assert len(fig.axes[0].get_lines()) == 3
+    assert len(fig.axes[0].get_lines()) == 5  # reference + (virtual point, CG) per run
     fig = plot_runs("chi", dict(runs))
     assert len(fig.axes[0].get_lines()) == 1  # only the run with chi_hat
     written = save_figure(plot_runs("overview", runs), tmp_path / "figs" / "fig3")

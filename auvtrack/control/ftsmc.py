@@ -10,7 +10,8 @@ mapped to the input through the same J3 / M_bar route as the paper's controller
 (:func:`auvtrack.control.tracking.input_for_accel`), with no prescribed performance and no
 estimator.  Then s_dot = -beta gamma |e_dot|^(gamma-1) (k1 sign s + k2 s + model error).
 
-Packed parameters ``cp`` = [beta, gamma, k1, k2]; no internal state; logged aux: s_x, s_y, s_z.
+Packed parameters ``cp`` = [beta, gamma, k1, k2]; no internal state; logged aux: sliding_x,
+sliding_y, sliding_z (s above).
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
 
 NAME = "ftsmc"
-AUX_NAMES = ("s_x", "s_y", "s_z")
+AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z")  # formerly s_* (auvtrack/simulation/channels.py)
 
 
 class Params(ControllerParams):

@@ -19,8 +19,8 @@ sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the sam
 eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
 
 Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels per axis: rho (envelope),
-rho1 (baseline envelope), chi_hat (estimate), S (sliding variable), g (envelope trigger) and
-z (transformed error).
+rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger)
+and zeta (z, the transformed error).
 """
 from __future__ import annotations
 
@@ -39,7 +39,8 @@ from .tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "fxtntsmc"
 AXES = ("x", "y", "z")
-AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "S", "g", "z") for a in AXES)
+# channel names (formerly S_* and z_*, still readable: auvtrack/simulation/channels.py)
+AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding", "g", "zeta") for a in AXES)
 
 # Packed parameters cp (built by :func:`setup`):
 #   0-11   kappa1, kappa2, kappa3, a1, a2, a3, a4, alpha, sigma, surface code, z_switch, z_floor

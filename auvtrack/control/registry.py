@@ -42,7 +42,7 @@ class CompiledController:
     xc0 : numpy.ndarray
         Initial internal state (adaptive weights, envelope filters, integrators); may be empty.
     aux_names : tuple of str
-        Names of the extra logged channels the controller writes (``rho_x``, ``S_x``, ...).
+        Names of the extra logged channels the controller writes (``rho_x``, ``sliding_x``, ...).
     notes : tuple of str
         Warnings to show the user (e.g. an initial envelope widening).
     resolved : dict

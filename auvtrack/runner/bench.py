@@ -111,13 +111,50 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
             "seconds": round(time.perf_counter() - t0, 2)}
 
 
+def user_bench_folder() -> Path:
+    """A new folder for one ``bench --all`` record, outside any source tree.
+
+    ``$XDG_DATA_HOME/auvtrack/bench/<UTC time>`` (``~/.local/share`` when unset), numbered if
+    two runs start in the same second.
+
+    Returns
+    -------
+    pathlib.Path
+        A path that does not exist yet.
+    """
+    import datetime
+
+    root = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share") / "auvtrack" / "bench"
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+    path, n = root / stamp, 1
+    while path.exists():
+        n += 1
+        path = root / f"{stamp}-{n}"
+    return path
+
+
 def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = False) -> dict:
     """The full benchmark suite; writes ``results.json`` and ``results.md`` into ``out``.
 
     Single-run µs per RK4 step for every controller, batch runs/s (10 s runs at dt = 1 ms) per
     back end, and sweep throughput on 1 and 2 Dask workers (see
-    :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to the source tree's ``benchmarks/``
-    when it exists, else the current folder.
+    :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to a new user folder
+    (:func:`user_bench_folder`), so running the suite from a clone leaves the working tree
+    unchanged; pass ``out=Path("benchmarks")`` to update the record kept in the repository.
+
+    Parameters
+    ----------
+    repeat : int, optional
+        Timed repetitions per row (the single runs use three times as many).
+    out : pathlib.Path, optional
+        Folder for the results.
+    progress : bool, optional
+        Print the name of each part as it starts.
+
+    Returns
+    -------
+    dict
+        The record written to ``results.json``, plus ``"out"``: the folder (not written).
     """
     from .sweep_bench import bench_batch, bench_breakdown, bench_sweep, write_results
 
@@ -133,11 +170,9 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     sweep = bench_sweep(repeat=max(3, repeat // 2))
     doc = {"machine": mach, "repeat": repeat, "single": single, "breakdown": breakdown, "batch": batch,
            "sweep": sweep}
-    if out is None:
-        tree = Path(__file__).resolve().parents[2] / "benchmarks"
-        out = tree if tree.is_dir() else Path.cwd()
-    write_results(doc, Path(out))
-    return doc
+    out = Path(out) if out is not None else user_bench_folder()
+    write_results(doc, out)
+    return {**doc, "out": out}
 
 
-__all__ = ["bench_single", "bench_singles", "bench_all", "warmup", "machine"]
+__all__ = ["bench_single", "bench_singles", "bench_all", "user_bench_folder", "warmup", "machine"]

@@ -269,26 +269,26 @@ def _finite_or_none(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def summarize(results: Path, spec: StudySpec) -> dict:
-    """Counts, failure rate, causes and per-metric quantiles (over "ok" samples) of a results file."""
+def group_keys(spec: StudySpec) -> list[str]:
+    """Grid keys whose values are names (``controller.kind``, ``vehicle.preset``...): one summary each.
+
+    Pooling the metrics of different controllers or vehicles gives quantiles of neither, so the
+    summary is grouped by every grid key whose values are all strings.
+    """
+    return [k for k, vals in spec.study.grid.items() if vals and all(isinstance(v, str) for v in vals)]
+
+
+def _stats(status, cause, columns: dict, mask) -> dict:
+    """Counts, causes and per-metric quantiles (over the ok samples) of the rows in ``mask``."""
     import numpy as np
-    import pyarrow.compute as pc
-    import pyarrow.parquet as pq
 
-    from ..simulation.metrics import METRIC_NAMES
-
-    status = pq.read_table(results, columns=["status", "cause"])
-    n = status.num_rows
-    counts = {k: int(v) for k, v in zip(*np.unique(status.column("status").to_numpy(zero_copy_only=False),
-                                                   return_counts=True))}
-    causes = {}
-    for k, v in zip(*np.unique(status.column("cause").to_numpy(zero_copy_only=False), return_counts=True)):
-        if k:
-            causes[str(k)] = int(v)
-    ok_mask = pc.equal(status.column("status"), "ok")
+    st, ca = status[mask], cause[mask]
+    counts = {str(k): int(v) for k, v in zip(*np.unique(st, return_counts=True))}
+    causes = {str(k): int(v) for k, v in zip(*np.unique(ca[ca != None], return_counts=True)) if k}  # noqa: E711
+    ok = st == "ok"
     metrics: dict[str, dict] = {}
-    for name in METRIC_NAMES:
-        col = pq.read_table(results, columns=[name]).column(name).filter(ok_mask).to_numpy()
+    for name, col in columns.items():
+        col = col[mask][ok]
         fin = col[np.isfinite(col)]
         entry: dict[str, Any] = {"n_finite": int(fin.size), "n_inf": int(np.isinf(col).sum())}
         if fin.size:
@@ -298,28 +298,72 @@ def summarize(results: Path, spec: StudySpec) -> dict:
                 entry[f"q{int(round(q * 100)):02d}"] = float(v)
             entry["max"] = float(fin.max())
         metrics[name] = entry
-    failed = counts.get("failed", 0)
-    invalid = counts.get("invalid", 0)
-    return {"study": spec.study.name, "source": spec.source, "samples": n, "counts": counts,
-            "failure_rate": failed / n if n else math.nan, "invalid_rate": invalid / n if n else math.nan,
-            "causes": causes, "varied": list(spec.varied), "quantile_levels": list(QUANTILES), "metrics": metrics}
+    n = int(mask.sum())
+    return {"samples": n, "counts": counts, "failure_rate": counts.get("failed", 0) / n if n else math.nan,
+            "invalid_rate": counts.get("invalid", 0) / n if n else math.nan, "causes": causes, "metrics": metrics}
+
+
+def summarize(results: Path, spec: StudySpec) -> dict:
+    """Counts, failure rate, causes and per-metric quantiles (over "ok" samples) of a results file.
+
+    The top level pools every sample; ``groups`` repeats the statistics for each combination of
+    the :func:`group_keys` values (e.g. one entry per controller), in grid order.
+    """
+    import itertools
+
+    import numpy as np
+    import pyarrow.parquet as pq
+
+    from ..simulation.metrics import METRIC_NAMES
+
+    keys = group_keys(spec)
+    table = pq.read_table(results, columns=["status", "cause", *keys, *METRIC_NAMES])
+    status = table.column("status").to_numpy(zero_copy_only=False)
+    cause = table.column("cause").to_numpy(zero_copy_only=False)
+    columns = {m: table.column(m).to_numpy() for m in METRIC_NAMES}
+    out = {"study": spec.study.name, "source": spec.source,
+           **_stats(status, cause, columns, np.ones(len(status), dtype=bool)),
+           "varied": list(spec.varied), "quantile_levels": list(QUANTILES), "group_keys": keys, "groups": []}
+    values = {k: table.column(k).to_numpy(zero_copy_only=False) for k in keys}
+    for combo in itertools.product(*(spec.study.grid[k] for k in keys)) if keys else ():
+        mask = np.logical_and.reduce([values[k] == v for k, v in zip(keys, combo)])
+        out["groups"].append({"key": dict(zip(keys, combo)), **_stats(status, cause, columns, mask)})
+    return out
 
 
 def summary_markdown(s: dict) -> str:
-    """Render a summary (from :func:`summarize`) as Markdown."""
+    """Render a summary (from :func:`summarize`) as Markdown: one quantile table per group."""
     lines = [f"# Sweep {s['study']}", "", f"Study file: `{s['source']}`; varied: "
              f"{', '.join(f'`{k}`' for k in s['varied']) or 'nothing (replicates only)'}.", "",
-             f"Samples: {s['samples']} — " + ", ".join(f"{k}: {v}" for k, v in sorted(s["counts"].items())) +
-             f"; failure rate {s['failure_rate']:.2%}" + (f", invalid {s['invalid_rate']:.2%}" if s["invalid_rate"]
-                                                          else "") + ".", ""]
+             f"Samples: {s['samples']} — " + _counts_text(s), ""]
     if s["causes"]:
         lines += ["Failure causes: " + ", ".join(f"{k} ({v})" for k, v in sorted(s["causes"].items())) + ".", ""]
     if "seconds" in s and s["seconds"]:
         lines += [f"Computed in {s['seconds']:.1f} s.", ""]
-    qs = [f"q{int(round(q * 100)):02d}" for q in s["quantile_levels"]]
-    lines += ["Metric quantiles over the ok samples (finite values; `inf` = never settled):", "",
-              "| metric | n | inf | mean | " + " | ".join(qs) + " |", "|---" * (4 + len(qs)) + "|"]
+    groups = s.get("groups") or []
+    if not groups:
+        return "\n".join(lines + _quantile_table(s, s["quantile_levels"])) + "\n"
+    lines += [f"Grouped by {', '.join(f'`{k}`' for k in s['group_keys'])}: the samples of different "
+              "groups are never pooled.", ""]
+    for g in groups:
+        name = ", ".join(f"{k} = {v}" for k, v in g["key"].items())
+        lines += [f"## {name}", "", f"Samples: {g['samples']} — " + _counts_text(g), ""]
+        if g["causes"]:
+            lines += ["Failure causes: " + ", ".join(f"{k} ({v})" for k, v in sorted(g["causes"].items())) + ".", ""]
+        lines += _quantile_table(g, s["quantile_levels"]) + [""]
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def _counts_text(s: dict) -> str:
+    return (", ".join(f"{k}: {v}" for k, v in sorted(s["counts"].items())) + f"; failure rate {s['failure_rate']:.2%}"
+            + (f", invalid {s['invalid_rate']:.2%}" if s["invalid_rate"] else "") + ".")
+
+
+def _quantile_table(s: dict, levels) -> list[str]:
+    qs = [f"q{int(round(q * 100)):02d}" for q in levels]
+    lines = ["Metric quantiles over the ok samples (finite values; `inf` = never settled):", "",
+             "| metric | n | inf | mean | " + " | ".join(qs) + " |", "|---" * (4 + len(qs)) + "|"]
     for name, e in s["metrics"].items():
         vals = [f"{e[k]:.4g}" if k in e else "–" for k in ["mean"] + qs]
         lines.append(f"| {name} | {e['n_finite']} | {e['n_inf']} | " + " | ".join(vals) + " |")
-    return "\n".join(lines) + "\n"
+    return lines

@@ -26,6 +26,7 @@ from ..plant.kinematics import attitude, virtual_point
 from ..plant.params import ELL
 from ..plant.presets import vehicle_arrays  # noqa: F401  (re-exported: studies use it from here)
 from ..reference import build_reference
+from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
 from . import engine, kernels
 from .engine import ControllerBundle, EnvironmentBundle, Outputs, PlantBundle, Settings
@@ -211,7 +212,7 @@ def prepare(scenario: Scenario) -> Prepared:
         ref_p=_c(ref_p), settings=Settings(si, sf),
         n_rows=n_steps // log_every + 1,
         channels=BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names),
-        notes=tuple(cpl.notes) + tuple(cc.notes),
+        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[ELL])] if n),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": cc.resolved},
         statuses={**CONTROLLER_STATUS, **cspec.statuses},

@@ -11,6 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence, Union
 
+import math
+
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
@@ -32,9 +34,13 @@ STYLE: dict[str, Any] = {
 }
 """rcParams applied while a figure is built (clean, paper-like)."""
 
-REF_STYLE = {"color": "k", "linestyle": "--", "linewidth": 1.0}
+REF_STYLE = {"color": "k", "linestyle": "--", "linewidth": 1.0, "zorder": 5}  # on top: runs that track it cover it
 BASE_ENV_STYLE = {"color": "0.45", "linestyle": "--", "linewidth": 0.9}
-POS_LABELS = {"x": "x (m)", "y": "y (m)", "z": "z (m)"}
+POS_LABELS = {"x": "x (m)", "y": "y (m)", "z": "z (m, positive down)"}
+VP_LABEL = r"virtual point $\eta_1$"
+CG_STYLE = {"linewidth": 0.6, "alpha": 0.55, "linestyle": "-"}
+START_MARKERS = ("o", "s", "^", "D", "v")
+AXIS_STYLES = ("-", "--", ":")
 ERR_LABELS = {"x": r"$e_x$ (m)", "y": r"$e_y$ (m)", "z": r"$e_z$ (m)"}
 VEL_LABELS = {"u": "u (m/s)", "v": "v (m/s)", "w": "w (m/s)", "q": "q (rad/s)", "r": "r (rad/s)"}
 TAU_LABELS = {"tau_u": r"$\tau_u$ (N)", "tau_q": r"$\tau_q$ (N$\cdot$m)", "tau_r": r"$\tau_r$ (N$\cdot$m)"}
@@ -136,22 +142,84 @@ def _series_panel(ax, runs, channel: str, t_range, *, reference: str | None = No
             ax.plot(res0.t[m], res0[reference][m], label="reference", **REF_STYLE)
 
 
-def _draw_trajectory3d(ax, runs, legend_loc: str = "upper left") -> None:
-    res0 = runs[0][1]
-    ax.plot(res0["xd"], res0["yd"], res0["zd"], label="reference", **REF_STYLE)
+def virtual_point_track(res: "Result") -> np.ndarray:
+    """Logged path of the virtual point eta1 = eta_d + e, the point every controller tracks.
+
+    The position channels ``x, y, z`` are the vehicle's centre of gravity; the virtual point lies
+    ``vehicle.l`` ahead of it on the body axis (paper eq. 2).  Since ``ex, ey, ez`` are logged
+    as eta1 - eta_d, the virtual point is recovered exactly, without re-deriving the kinematics.
+
+    Parameters
+    ----------
+    res : Result
+        A simulation result.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(len(res), 3)``: x, y, z of eta1 (m, NED).
+    """
+    return np.column_stack([res[f"{a}d"] + res[f"e{a}"] for a in AXES]) if len(res) else np.zeros((0, 3))
+
+
+def lever_arm(res: "Result") -> float | None:
+    """The virtual-point offset ``vehicle.l`` (m) recorded in a result's scenario, if any.
+
+    Parameters
+    ----------
+    res : Result
+        A simulation result.
+
+    Returns
+    -------
+    float or None
+        ell (m), or ``None`` when the scenario does not record it.
+    """
+    sc = res.scenario if isinstance(res.scenario, Mapping) else {}
+    for src in ((sc.get("resolved") or {}).get("vehicle"), sc.get("vehicle")):
+        if isinstance(src, Mapping) and isinstance(src.get("l"), (int, float)):
+            return float(src["l"])
+    return None
+
+
+def _vp_title(runs) -> str:
+    ell = lever_arm(runs[0][1])
+    where = f"{ell:g} m ahead of the CG" if ell is not None else "ahead of the CG"
+    return rf"virtual point $\eta_1$ ({where}) vs reference $\eta_d$; thin: centre of gravity"
+
+
+def _draw_trajectory3d(ax, runs, cg: bool = True) -> None:
+    """Virtual points (and CGs), then the reference on top: it is covered wherever tracking is exact."""
+    ax.computed_zorder = False  # draw in call order, so the dashed reference stays visible
     for i, (label, res) in enumerate(runs):
-        ax.plot(res["x"], res["y"], res["z"], color=_color(i), label=label)
-        if res.t.size:
-            ax.scatter([res["x"][0]], [res["y"][0]], [res["z"][0]], color=_color(i), marker="o", s=12)
+        vp = virtual_point_track(res)
+        if cg:
+            ax.plot(res["x"], res["y"], res["z"], color=_color(i), label=f"{label}: CG", **CG_STYLE)
+        ax.plot(vp[:, 0], vp[:, 1], vp[:, 2], color=_color(i), label=f"{label}: {VP_LABEL}")
+    res0 = runs[0][1]
+    ax.plot(res0["xd"], res0["yd"], res0["zd"], label=r"reference $\eta_d$", **REF_STYLE)
+    if len(res0):
+        ax.scatter([res0["xd"][0]], [res0["yd"][0]], [res0["zd"][0]], color="k", marker="x", s=30,
+                   label=r"$\eta_d(0)$")
+    for i, (label, res) in enumerate(runs):
+        if res.t.size:  # hollow markers of decreasing size: every run's start stays visible
+            vp0 = virtual_point_track(res)[0]
+            ax.scatter([vp0[0]], [vp0[1]], [vp0[2]], facecolors="none", edgecolors=_color(i),
+                       marker=START_MARKERS[i % len(START_MARKERS)], s=max(70 - 25 * i, 20), linewidths=1.3,
+                       label=f"{label}: start")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_zlabel("z (m)")
-    ax.legend(loc=legend_loc)
+    ax.set_zlabel("z (m, positive down)")
+    ax.invert_zaxis()  # NED: z points down, so up in the figure is up in the water
 
 
-def fig_trajectory3d(runs: "Runs", *, figsize: tuple[float, float] = (5.5, 4.5),
-                     title: str | None = None) -> Figure:
-    """3-D path of each run against the reference (paper Figure 3).
+def fig_trajectory3d(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.0),
+                     title: str | None = None, cg: bool = True) -> Figure:
+    """3-D path of each run's virtual point against the reference (paper Figure 3).
+
+    The controllers track the virtual point eta1 (``vehicle.l`` ahead of the centre of gravity,
+    paper eq. 2), so that is what is drawn against eta_d; the CG path is a thin line of the same
+    colour.  The z axis points down (NED).
 
     Parameters
     ----------
@@ -160,20 +228,22 @@ def fig_trajectory3d(runs: "Runs", *, figsize: tuple[float, float] = (5.5, 4.5),
     figsize : tuple of float, optional
         Figure size in inches.
     title : str, optional
-        Figure title.
+        Figure title (default: what is drawn).
+    cg : bool, optional
+        Also draw the centre of gravity (thin line).
 
     Returns
     -------
     matplotlib.figure.Figure
-        One 3-D axes; start points are marked with dots.
+        One 3-D axes; each run's start is a hollow marker of its own shape and size.
     """
     runs = normalize_runs(runs)
     with matplotlib.rc_context(STYLE):
         fig = _new_figure(figsize)
         ax = fig.add_subplot(projection="3d")
-        _draw_trajectory3d(ax, runs)
-        if title:
-            ax.set_title(title)
+        _draw_trajectory3d(ax, runs, cg=cg)
+        ax.set_title(title or _vp_title(runs), fontsize=8)
+        fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize=7)
     return fig
 
 
@@ -190,9 +260,27 @@ def _time_figure(runs, panels: Sequence[tuple[str, str, str | None]], figsize, t
     return fig
 
 
+def _position_panel(ax, runs, i: int, t_range, cg: bool) -> None:
+    """Reference, then each run's virtual point (and its CG, thin) on axis ``AXES[i]``."""
+    a = AXES[i]
+    res0 = runs[0][1]
+    m0 = _mask(res0, t_range)
+    ax.plot(res0.t[m0], res0[f"{a}d"][m0], label=r"reference $\eta_d$", **REF_STYLE)
+    for k, (label, res) in enumerate(runs):
+        m = _mask(res, t_range)
+        ax.plot(res.t[m], virtual_point_track(res)[m, i], color=_color(k), label=f"{label}: {VP_LABEL}")
+        if cg:
+            ax.plot(res.t[m], res[a][m], color=_color(k), label=f"{label}: CG", **CG_STYLE)
+    ax.set_ylabel(POS_LABELS[a])
+
+
 def fig_positions(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.5), title: str | None = None,
-                  t_range: tuple[float, float] | None = None) -> Figure:
-    """Positions x, y, z of each run against the reference, three panels (paper Figure 4).
+                  t_range: tuple[float, float] | None = None, cg: bool = True) -> Figure:
+    """Virtual-point position x, y, z of each run against the reference, three panels (paper Figure 4).
+
+    The controllers track the virtual point eta1 = eta_d + e (``vehicle.l`` ahead of the centre
+    of gravity); plotting the CG instead would show a lag and a depth offset that is not a
+    tracking error.  The CG is drawn as a thin line of the run's colour.
 
     Parameters
     ----------
@@ -201,17 +289,26 @@ def fig_positions(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.5), ti
     figsize : tuple of float, optional
         Figure size in inches.
     title : str, optional
-        Figure title.
+        Figure title (default: what is drawn).
     t_range : tuple of float, optional
         Time interval (s) to show.
+    cg : bool, optional
+        Also draw the centre of gravity (thin line).
 
     Returns
     -------
     matplotlib.figure.Figure
         Three axes sharing the time axis.
     """
-    panels = [(a, POS_LABELS[a], f"{a}d") for a in AXES]
-    return _time_figure(runs, panels, figsize, title, t_range)
+    runs = normalize_runs(runs)
+    with matplotlib.rc_context(STYLE):
+        fig = _new_figure(figsize)
+        axes = fig.subplots(3, 1, sharex=True)
+        for i, ax in enumerate(axes):
+            _position_panel(ax, runs, i, t_range, cg)
+        _finish_time_axes(axes, title or _vp_title(runs), fig, legend=False)
+        fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=3, fontsize=7)
+    return fig
 
 
 def fig_velocities(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 7.5), title: str | None = None,
@@ -238,9 +335,76 @@ def fig_velocities(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 7.5), t
     return _time_figure(runs, panels, figsize, title, t_range)
 
 
-def fig_inputs(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.5), title: str | None = None,
-               t_range: tuple[float, float] | None = None) -> Figure:
-    """Control inputs tau_u, tau_q, tau_r of each run, three panels (paper Figure 6).
+def steady_start(runs: "Runs", steady_from: float) -> float:
+    """Start (s) of the steady-state panels: ``steady_from``, or half the shortest run if it ends sooner.
+
+    Parameters
+    ----------
+    runs : Result, dict or sequence of (str, Result)
+        Runs to draw.
+    steady_from : float
+        Requested start of the steady state (s).
+
+    Returns
+    -------
+    float
+        The start actually used.
+    """
+    ends = [float(res.t[-1]) for _, res in normalize_runs(runs) if res.t.size]
+    if not ends:
+        return float(steady_from)
+    t_end = min(ends)
+    return float(steady_from) if t_end > steady_from else 0.5 * t_end
+
+
+def total_variation_rate(t: np.ndarray, x: np.ndarray) -> float:
+    """Total variation of the samples ``x`` per second, sum |x[k+1] - x[k]| / (t[-1] - t[0]).
+
+    Parameters
+    ----------
+    t, x : numpy.ndarray
+        Sample times (s) and values; non-finite samples are ignored.
+
+    Returns
+    -------
+    float
+        Variation per second (units of x per s); 0 for fewer than two finite samples.
+    """
+    ok = np.isfinite(x) & np.isfinite(t)
+    t, x = t[ok], x[ok]
+    if t.size < 2 or t[-1] <= t[0]:
+        return 0.0
+    return float(np.abs(np.diff(x)).sum() / (t[-1] - t[0]))
+
+
+def _smooth_last(runs, channel: str, t_range) -> list[int]:
+    """Run indices ordered by decreasing variation of ``channel`` on ``t_range``: the smoothest is drawn last."""
+    def tv(res):
+        if channel not in res:
+            return 0.0
+        m = _mask(res, t_range)
+        return total_variation_rate(res.t[m], res[channel][m])
+
+    return sorted(range(len(runs)), key=lambda k: -tv(runs[k][1]))
+
+
+def _input_panel(ax, runs, channel: str, t_range, order: Sequence[int]) -> None:
+    for z, k in enumerate(order):
+        label, res = runs[k]
+        if channel not in res:
+            continue
+        m = _mask(res, t_range)
+        ax.plot(res.t[m], res[channel][m], color=_color(k), label=label, zorder=2 + z)
+
+
+def fig_inputs(runs: "Runs", *, figsize: tuple[float, float] = (9.0, 5.5), title: str | None = None,
+               t_range: tuple[float, float] | None = None, steady_from: float | None = 20.0) -> Figure:
+    """Control inputs tau_u, tau_q, tau_r of each run, with a steady-state column (paper Figure 6).
+
+    The start-up spikes (hundreds of N) set the scale of a whole-run plot, which hides the
+    chattering the controllers are compared on; the right-hand column shows t >= ``steady_from``
+    on its own scale.  In every panel the runs are drawn in order of decreasing total variation
+    on the steady-state interval, so the smoothest line is on top.
 
     Parameters
     ----------
@@ -251,41 +415,154 @@ def fig_inputs(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.5), title
     title : str, optional
         Figure title.
     t_range : tuple of float, optional
-        Time interval (s) to show.
+        Time interval (s) of the left-hand column.
+    steady_from : float or None, optional
+        Start (s) of the steady-state column (:func:`steady_start`: half the shortest run if
+        that ends sooner); ``None`` draws the left-hand column only.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Three axes sharing the time axis.
+        Three axes sharing the time axis, plus three steady-state axes unless ``steady_from`` is None.
     """
-    panels = [(c, lab, None) for c, lab in TAU_LABELS.items()]
-    return _time_figure(runs, panels, figsize, title, t_range)
+    runs = normalize_runs(runs)
+    ncol = 1 if steady_from is None else 2
+    with matplotlib.rc_context(STYLE):
+        fig = _new_figure(figsize if ncol == 2 else (6.0, figsize[1]))
+        grid = fig.subplots(3, ncol, sharex="col", squeeze=False)
+        t_ss = None if steady_from is None else steady_start(runs, steady_from)
+        ss_range = None if t_ss is None else (t_ss, t_range[1] if t_range else math.inf)
+        for r, (ch, lab) in enumerate(TAU_LABELS.items()):
+            order = _smooth_last(runs, ch, ss_range or t_range)
+            _input_panel(grid[r, 0], runs, ch, t_range, order)
+            grid[r, 0].set_ylabel(lab)
+            if ncol == 2:
+                _input_panel(grid[r, 1], runs, ch, ss_range, order)
+                grid[r, 1].set_ylabel(lab)
+        _finish_time_axes(grid[:, 0], title, fig, legend=False)
+        handles = dict(zip(*reversed(grid[0, 0].get_legend_handles_labels())))  # label -> handle
+        named = [lab for lab, _ in runs if lab in handles]
+        if named:
+            grid[0, 0].legend([handles[lab] for lab in named], named, loc="best")  # in run order
+        if ncol == 2:
+            _finish_time_axes(grid[:, 1], None, fig, legend=False)
+            grid[0, 1].set_title(f"steady state, t ≥ {t_ss:g} s (own scale; smoothest line on top)")
+            grid[0, 0].set_title("whole run")
+    return fig
+
+
+def _axis_envelope(res, a: str, m) -> tuple[np.ndarray, np.ndarray] | None:
+    """(rho, rho1 or None) of axis ``a`` on mask ``m`` if the run logs a finite envelope."""
+    if f"rho_{a}" not in res:
+        return None
+    rho = res[f"rho_{a}"][m]
+    if not np.isfinite(rho).any():  # envelope.kind = "none" logs NaN
+        return None
+    rho1 = res[f"rho1_{a}"][m] if f"rho1_{a}" in res else None
+    return rho, rho1
 
 
 def _draw_error_panel(ax, runs, a: str, t_range, envelopes: bool) -> None:
     _series_panel(ax, runs, f"e{a}", t_range)
+    ax.set_ylabel(ERR_LABELS[a])
     if not envelopes:
         return
     base_done = False
     for i, (label, res) in enumerate(runs):
         m = _mask(res, t_range)
-        t = res.t[m]
-        if f"rho_{a}" in res:
-            rho = res[f"rho_{a}"][m]
-            ax.plot(t, rho, color=_color(i), linestyle="-.", linewidth=0.9, alpha=0.8,
-                    label=rf"$\pm\rho$ ({label})")
-            ax.plot(t, -rho, color=_color(i), linestyle="-.", linewidth=0.9, alpha=0.8)
-        if f"rho1_{a}" in res and not base_done:  # the baseline envelope is the same for every run
-            rho1 = res[f"rho1_{a}"][m]
+        env = _axis_envelope(res, a, m)
+        if env is None:
+            continue
+        t, (rho, rho1) = res.t[m], env
+        ax.plot(t, rho, color=_color(i), linestyle="-.", linewidth=0.9, alpha=0.8, label=rf"$\pm\rho$ ({label})")
+        ax.plot(t, -rho, color=_color(i), linestyle="-.", linewidth=0.9, alpha=0.8)
+        if rho1 is not None and not base_done:  # the baseline envelope is the same for every run
             ax.plot(t, rho1, label=r"$\pm\rho_1$ (baseline)", **BASE_ENV_STYLE)
             ax.plot(t, -rho1, **BASE_ENV_STYLE)
             base_done = True
-    ax.set_ylabel(ERR_LABELS[a])
 
 
-def fig_errors(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.5), title: str | None = None,
+def _draw_log_error_panel(ax, runs, a: str, t_range) -> None:
+    """|e_a| of every run and the envelope rho_a, rho1_a on a log scale: the envelope stays visible."""
+    base_done = False
+    for i, (label, res) in enumerate(runs):
+        m = _mask(res, t_range)
+        t = res.t[m]
+        env = _axis_envelope(res, a, m)
+        if env is not None:
+            rho, rho1 = env
+            if rho1 is not None and not base_done:
+                ax.plot(t, rho1, label="_baseline", **BASE_ENV_STYLE)
+                base_done = True
+            ax.plot(t, rho, color=_color(i), linestyle="-.", linewidth=0.9, alpha=0.8, label=f"_rho {label}")
+        ax.plot(t, np.abs(res[f"e{a}"][m]), color=_color(i), label=f"_{label}")
+    ax.set_yscale("log")
+    ax.set_ylabel(rf"$|e_{a}|$ (m, log)")
+
+
+def _draw_ratio_panel(ax, runs, t_range) -> list[str]:
+    """|e_i| / rho_i per axis for the runs with an envelope (a run fails where it reaches 1); the peaks."""
+    peaks = []
+    for i, (label, res) in enumerate(runs):
+        m = _mask(res, t_range)
+        run_peaks = []
+        for a, ls in zip(AXES, AXIS_STYLES):
+            env = _axis_envelope(res, a, m)
+            if env is None:
+                continue
+            ratio = np.abs(res[f"e{a}"][m]) / env[0]
+            ax.plot(res.t[m], ratio, color=_color(i), linestyle=ls, linewidth=1.0, label=f"_{label} {a}")
+            if np.isfinite(ratio).any():
+                run_peaks.append(f"{a} {np.nanmax(ratio):.2g}")
+        if run_peaks:
+            peaks.append(f"{label}: " + ", ".join(run_peaks))
+    ax.axhline(1.0, color="k", linewidth=0.9, label="_boundary")
+    ax.set_yscale("log")
+    if peaks:
+        ax.set_ylim(top=10.0)
+    ax.set_ylabel(r"$|e_i| / \rho_i$ (log)")
+    return peaks
+
+
+def _draw_widening_panel(ax, runs, t_range) -> bool:
+    """The flexible part rho_bar = rho - rho1 of the envelope (eq. 25), per axis."""
+    drawn = False
+    for i, (label, res) in enumerate(runs):
+        m = _mask(res, t_range)
+        for a, ls in zip(AXES, AXIS_STYLES):
+            env = _axis_envelope(res, a, m)
+            if env is None or env[1] is None:
+                continue
+            ax.plot(res.t[m], env[0] - env[1], color=_color(i), linestyle=ls, linewidth=1.0, label=f"_{label} {a}")
+            drawn = True
+    ax.set_ylabel(r"$\bar\rho_i = \rho_i - \rho_{1,i}$ (m)")
+    return drawn
+
+
+def _errors_legend(fig, ax) -> None:
+    """One legend below the figure: runs and envelopes, the axis line styles, the failure boundary."""
+    from matplotlib.lines import Line2D
+
+    handles, labels = ax.get_legend_handles_labels()
+    for a, ls in zip(AXES, AXIS_STYLES):
+        handles.append(Line2D([], [], color="0.3", linestyle=ls, linewidth=1.0))
+        labels.append(f"axis {a} (bottom row)")
+    handles.append(Line2D([], [], color="k", linewidth=0.9))
+    labels.append(r"$|e_i| = \rho_i$: failure")
+    fig.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=7)
+
+
+def fig_errors(runs: "Runs", *, figsize: tuple[float, float] = (10.0, 8.0), title: str | None = None,
                t_range: tuple[float, float] | None = None, envelopes: bool = True) -> Figure:
-    """Position errors e_x, e_y, e_z with the prescribed-performance envelopes (paper Figure 7).
+    """Position errors with the prescribed-performance envelopes (paper Figure 7), readable at every scale.
+
+    Left column: e_x, e_y, e_z with ``±rho`` (dash-dot, the run's colour) and the baseline
+    ``±rho1`` (dashed grey), as in the paper.  After the envelope has shrunk to its final
+    width (5 mm in Section 4) that is invisible on a metre scale, so the right column shows
+    |e| with rho and rho1 on a log scale; the bottom row shows |e_i| / rho_i on a log scale (a
+    run fails when it reaches 1) and the flexible part rho_bar = rho - rho1 of the envelope
+    (paper eq. 25).  Runs without an envelope (FTSMC, ``envelope.kind = "none"``) appear in
+    the error panels only.
 
     Parameters
     ----------
@@ -298,21 +575,40 @@ def fig_errors(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.5), title
     t_range : tuple of float, optional
         Time interval (s) to show.
     envelopes : bool, optional
-        Draw ``±rho_*`` (dash-dot, the run's colour) for runs that log it, and the baseline
-        ``±rho1_*`` (dashed grey) once if logged.
+        Draw the envelopes and the two envelope panels; ``False`` gives the three error panels only.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Three axes sharing the time axis.
+        Eight axes (error | log |e| per axis, then |e|/rho | rho_bar), or three without envelopes.
     """
     runs = normalize_runs(runs)
     with matplotlib.rc_context(STYLE):
-        fig = _new_figure(figsize)
-        axes = fig.subplots(3, 1, sharex=True)
-        for ax, a in zip(axes, AXES):
-            _draw_error_panel(ax, runs, a, t_range, envelopes)
-        _finish_time_axes(axes, title, fig)
+        fig = _new_figure(figsize if envelopes else (6.0, 5.5))
+        if not envelopes:
+            axes = fig.subplots(3, 1, sharex=True)
+            for ax, a in zip(axes, AXES):
+                _draw_error_panel(ax, runs, a, t_range, False)
+            _finish_time_axes(axes, title, fig)
+            return fig
+        grid = fig.subplots(4, 2, sharex=True)
+        for r, a in enumerate(AXES):
+            _draw_error_panel(grid[r, 0], runs, a, t_range, True)
+            _draw_log_error_panel(grid[r, 1], runs, a, t_range)
+        peaks = _draw_ratio_panel(grid[3, 0], runs, t_range)
+        if not peaks:
+            _note(grid[3, 0], "no run logs an envelope")
+        if not _draw_widening_panel(grid[3, 1], runs, t_range):
+            _note(grid[3, 1], "no run logs a flexible envelope")
+        for c in range(2):
+            _finish_time_axes(grid[:, c], None, fig, legend=False)
+        _errors_legend(fig, grid[0, 0])
+        grid[0, 0].set_title("errors and envelopes (linear)")
+        grid[0, 1].set_title("|e| and envelopes (log scale)")
+        grid[3, 0].set_title("|e| / envelope; max " + "; ".join(peaks) if peaks else "|e| / envelope", fontsize=7)
+        grid[3, 1].set_title("flexible part of the envelope (risk monitor and start widening)", fontsize=7)
+        if title:
+            fig.suptitle(title)
     return fig
 
 
@@ -363,7 +659,7 @@ def fig_chi(runs: "Runs", *, figsize: tuple[float, float] = (6.0, 5.5), title: s
 
 def fig_overview(runs: "Runs", *, figsize: tuple[float, float] = (14.0, 7.0), title: str | None = None,
                  t_range: tuple[float, float] | None = None) -> Figure:
-    """Grid of the main panels: 3-D path | positions | errors (with envelopes) | inputs.
+    """Grid of the main panels: 3-D path | virtual-point positions | errors (with envelopes) | inputs.
 
     Parameters
     ----------
@@ -389,14 +685,14 @@ def fig_overview(runs: "Runs", *, figsize: tuple[float, float] = (14.0, 7.0), ti
         gs = fig.add_gridspec(3, 4, width_ratios=(1.7, 1, 1, 1))
         ax3 = fig.add_subplot(gs[:, 0], projection="3d")
         ax3.set_box_aspect(None, zoom=0.82)  # keep the z label clear of the next column
-        _draw_trajectory3d(ax3, runs, legend_loc="upper center")
+        _draw_trajectory3d(ax3, runs, cg=False)
+        ax3.legend(loc="upper center", fontsize=7)
         cols = []
         for c in range(1, 4):
             first = fig.add_subplot(gs[0, c])
             cols.append([first] + [fig.add_subplot(gs[r, c], sharex=first) for r in (1, 2)])
         for r, a in enumerate(AXES):
-            _series_panel(cols[0][r], runs, a, t_range, reference=f"{a}d")
-            cols[0][r].set_ylabel(POS_LABELS[a])
+            _position_panel(cols[0][r], runs, r, t_range, cg=False)
             _draw_error_panel(cols[1][r], runs, a, t_range, True)
         for r, (ch, lab) in enumerate(TAU_LABELS.items()):
             _series_panel(cols[2][r], runs, ch, t_range)
@@ -474,5 +770,6 @@ def save_figure(fig: Figure, path_without_ext: str | Path, formats: Iterable[str
     return written
 
 
-__all__ = ["KINDS", "STYLE", "fig_trajectory3d", "fig_positions", "fig_velocities", "fig_inputs",
+__all__ = ["KINDS", "STYLE", "virtual_point_track", "lever_arm", "steady_start", "total_variation_rate",
+           "fig_trajectory3d", "fig_positions", "fig_velocities", "fig_inputs",
            "fig_errors", "fig_chi", "fig_overview", "plot_runs", "save_figure", "normalize_runs", "run_label"]

@@ -14,6 +14,8 @@ from typing import Any, Iterator, Mapping
 
 import numpy as np
 
+from .channels import current_name, legacy_columns, upgrade_names
+
 BASE_CHANNELS: tuple[str, ...] = ("t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r",
                                   "tau_u", "tau_q", "tau_r", "xd", "yd", "zd", "ex", "ey", "ez")
 """Channels every result starts with, in this order (SI units: s, m, rad, m/s, rad/s, N, N m)."""
@@ -126,7 +128,7 @@ class Result:
     channels : mapping of str to array_like
         Equal-length 1-D arrays, insertion-ordered, starting with :data:`BASE_CHANNELS`
         (``t, x, y, z, theta, psi, u, v, w, q, r, tau_u, tau_q, tau_r, xd, yd, zd, ex, ey, ez``),
-        optionally followed by extra channels (``rho_x``, ``chi_hat_x``, ``S_x``...).  Names must
+        optionally followed by extra channels (``rho_x``, ``chi_hat_x``, ``sliding_x``...).  Names must
         be identifiers of at most 63 characters (valid CSV headers and MATLAB variables).
     scenario : mapping
         The resolved scenario (JSON-compatible dict).
@@ -230,15 +232,23 @@ class Result:
         return float(t[-1] - t[0]) if t.size > 1 else 0.0
 
     def __getitem__(self, name: str) -> np.ndarray:
-        """Return channel ``name`` (read-only array)."""
+        """Return channel ``name`` (read-only array); an old channel name warns and still works."""
         try:
             return self._ch[name]
         except KeyError:
+            new = current_name(name, self._ch, self._kind())
+            if new is not None:
+                return self._ch[new]
             raise KeyError(f"no channel {name!r}; available: {', '.join(self._ch)}") from None
 
     def __contains__(self, name: object) -> bool:
-        """Whether a channel called ``name`` exists."""
-        return name in self._ch
+        """Whether a channel called ``name`` exists (old channel names included, see ``channels``)."""
+        return name in self._ch or (isinstance(name, str) and
+                                    current_name(name, self._ch, self._kind(), warn=False) is not None)
+
+    def _kind(self) -> str | None:
+        ctrl = self.scenario.get("controller")
+        return ctrl.get("kind") if isinstance(ctrl, Mapping) else None
 
     def __iter__(self) -> Iterator[str]:
         """Iterate over channel names."""
@@ -266,17 +276,28 @@ class Result:
         return f"Result({', '.join(parts)})"
 
     # ---- conversion
-    def to_pandas(self):
+    def to_pandas(self, legacy_names: bool = True):
         """Return the channels as a :class:`pandas.DataFrame`.
+
+        Parameters
+        ----------
+        legacy_names : bool, optional
+            Also add the renamed channels under their old names (``S_x``, ``z_x`` of the FXTNTSMC,
+            ``s_x`` of the FTSMC), after every channel.  Deprecated: these columns disappear in
+            the next release (:mod:`auvtrack.simulation.channels`); pass ``False`` to drop them now.
 
         Returns
         -------
         pandas.DataFrame
-            One column per channel, in order (``t`` first), one row per sample.
+            One column per channel, in order (``t`` first), one row per sample, then the old
+            names, if any.
         """
         import pandas as pd
 
-        return pd.DataFrame({k: np.array(v) for k, v in self._ch.items()}, columns=list(self._ch))
+        cols = {k: np.array(v) for k, v in self._ch.items()}
+        if legacy_names:
+            cols.update({old: np.array(self._ch[new]) for old, new in legacy_columns(self._ch, self._kind()).items()})
+        return pd.DataFrame(cols, columns=list(cols))
 
     def plot(self, kind: str = "overview", **kw: Any):
         """Draw this result (see :mod:`auvtrack.simulation.plotting`).
@@ -396,7 +417,8 @@ class Result:
         lines = (folder / CSV_NAME).read_text(encoding="utf-8").splitlines()
         if not lines:
             raise ValueError(f"{folder / CSV_NAME} is empty")
-        names = lines[0].split(",")
+        ctrl = (doc.get("scenario") or {}).get("controller")
+        names = upgrade_names(lines[0].split(","), ctrl.get("kind") if isinstance(ctrl, Mapping) else None)
         if len(lines) > 1:
             data = np.loadtxt(lines[1:], delimiter=",", dtype=np.float64, ndmin=2)
         else:

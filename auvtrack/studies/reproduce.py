@@ -2,7 +2,9 @@
 
 Runs the packaged Section 4 scenario with the FXTNTSMC and with the FTSMC baseline, writes a
 run folder for each, the paper's Figures 3-8 (PNG and PDF), a metrics table (Markdown and
-JSON) and a verdict on each of the paper's three claims computed from the measured numbers.
+JSON) and a verdict on each of the paper's three claims computed from the measured numbers;
+``summary.md`` and the self-contained ``report.html`` hold the same report
+(:class:`~auvtrack.studies.report.Report`).
 """
 from __future__ import annotations
 
@@ -20,6 +22,7 @@ from ..simulation.api import prepare, run_prepared
 from ..simulation.result import Result
 from ..scenario import load_scenario
 from ..scenario import paper_scenario_path
+from .report import Report
 
 CONTROLLERS = (("FXTNTSMC", "fxtntsmc"), ("FTSMC", "ftsmc"))
 # the same comparison with both controllers tuned by one procedure (docs/tuning.md)
@@ -34,6 +37,23 @@ FIGURES = (
     ("fig7_errors", plotting.fig_errors),
     ("fig8_chi", plotting.fig_chi),
 )
+CAPTIONS = {
+    "fig3_trajectory3d": "Fig. 3: path of the virtual point η₁ (the point the controllers track, vehicle.l = {ell} ahead "
+                         "of the centre of gravity) against the reference η_d (dashed); the thin lines are the centres "
+                         "of gravity, which trail the virtual point by design. Hollow markers: each run's start. The "
+                         "z axis points down (NED).",
+    "fig4_positions": "Fig. 4: virtual-point position η₁ against the reference η_d (dashed) per axis; thin lines: "
+                      "centre of gravity, vehicle.l = {ell} behind it along the body axis (not a tracking error).",
+    "fig5_velocities": "Fig. 5: body velocities u, v, w and rates q, r.",
+    "fig6_inputs": "Fig. 6: control inputs; left the whole run (its scale is set by the start-up spikes), right the "
+                   "steady state t ≥ {t_ss:g} s on its own scale, where the chattering claim is judged (the window "
+                   "of the steady-state metrics); the smoother line is drawn on top.",
+    "fig7_errors": "Fig. 7: position errors e = η₁ − η_d. Left: with the envelope ±ρ (dash-dot) and the baseline ±ρ₁ "
+                   "(dashed), linear as in the paper; right: |e| and the envelopes on a log scale, where the final "
+                   "envelope stays visible. Bottom: |e_i|/ρ_i (a run fails where it reaches 1) and the flexible part "
+                   "ρ̄ = ρ − ρ₁ of the envelope. The FTSMC has no envelope.",
+    "fig8_chi": "Fig. 8: approximation error χ − χ̂ of the RBF network (FXTNTSMC only; the FTSMC has no estimator).",
+}
 
 
 @dataclass
@@ -67,11 +87,11 @@ def preset_overrides(name: str) -> list[str]:
     return [f"controller.{k}={v!r}" for k, v in get_gain_preset(name).gains.items()]
 
 
-def _render(job: tuple[str, list, Path]) -> str:
+def _render(job: tuple[str, list, Path, dict]) -> str:
     """Draw and save one figure (runs in a worker process)."""
-    name, pairs, fig_dir = job
+    name, pairs, fig_dir, kw = job
     fn = dict(FIGURES)[name]
-    plotting.save_figure(fn(pairs), fig_dir / name)
+    plotting.save_figure(fn(pairs, **kw), fig_dir / name)
     return name
 
 
@@ -98,16 +118,14 @@ def verdicts(full: dict[str, dict], steady: dict[str, dict], window: tuple[float
     ]
 
 
-def _table(full: dict[str, dict], steady: dict[str, dict], window: tuple[float, float]) -> str:
+def _table_rows(full: dict[str, dict], steady: dict[str, dict], window: tuple[float, float]) -> list[list[str]]:
     keys = ([f"settle_{s}_{a}" for s in ("5cm", "1cm", "1mm") for a in AXES]
             + [f"rmse_{a}" for a in AXES] + [f"max_abs_{a}" for a in AXES] + [f"itae_{a}" for a in AXES]
             + [f"max_abs_tau_{j}" for j in INPUTS] + [f"energy_tau_{j}" for j in INPUTS] + [f"tv_tau_{j}" for j in INPUTS])
-    lines = ["| metric | window | FXTNTSMC | FTSMC |", "|---|---|---|---|"]
-    for k in keys:
-        lines.append(f"| {k} | whole run | {_fmt(full['FXTNTSMC'][k])} | {_fmt(full['FTSMC'][k])} |")
+    rows = [[k, "whole run", _fmt(full["FXTNTSMC"][k]), _fmt(full["FTSMC"][k])] for k in keys]
     for k in [f"rmse_{a}" for a in AXES] + [f"max_abs_{a}" for a in AXES] + [f"tv_tau_{j}" for j in INPUTS]:
-        lines.append(f"| {k} | [{window[0]:g}, {window[1]:g}] s | {_fmt(steady['FXTNTSMC'][k])} | {_fmt(steady['FTSMC'][k])} |")
-    return "\n".join(lines)
+        rows.append([k, f"[{window[0]:g}, {window[1]:g}] s", _fmt(steady["FXTNTSMC"][k]), _fmt(steady["FTSMC"][k])])
+    return rows
 
 
 def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
@@ -125,7 +143,9 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     Returns
     -------
     str
-        The Markdown summary also written to ``out/summary.md``.
+        The Markdown summary written to ``out/summary.md`` (which also ends with the scenarios
+        and the version); ``out/report.html`` holds the same report as one self-contained page,
+        figures embedded.
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -146,7 +166,8 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
         tuned[label], tuned_full[label], tuned_steady[label] = res, res.metrics, res_ss.metrics
         bar.update()
     pairs = list(runs.items())
-    jobs = [(name, pairs, out / "figures") for name, _ in FIGURES]
+    kw = {"fig6_inputs": {"steady_from": window[0]}}
+    jobs = [(name, pairs, out / "figures", kw.get(name, {})) for name, _ in FIGURES]
     with ProcessPoolExecutor(max_workers=2) as pool:  # figures are independent: use both cores
         for name in pool.map(_render, jobs):
             bar.set_postfix_str(name)
@@ -154,8 +175,12 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     bar.close()
     vs = verdicts(full, steady, window)
     vs_tuned = verdicts(tuned_full, tuned_steady, window)
-    summary = _summary(runs, full, steady, vs, window) + _tuned_summary(tuned, tuned_full, tuned_steady, vs_tuned, window)
-    (out / "summary.md").write_text(summary)
+    rep = _report(out, runs, full, steady, vs, window)
+    _tuned_report(rep, tuned, vs_tuned)
+    _figures(rep, runs, window)
+    for label, r in runs.items():
+        rep.scenario(_shown_scenario(r), f"Scenario of the {label} run (resolved; run folder `{r.scenario['controller']['kind']}/`)")
+    rep.write("summary.md", html="report.html")
     (out / "metrics.json").write_text(json.dumps(
         {"full_window": _jsonable(full), "steady_window": {"window": list(window), **_jsonable(steady)},
          "status": {k: r.status for k, r in runs.items()},
@@ -164,7 +189,7 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
                    "steady_window": {"window": list(window), **_jsonable(tuned_steady)},
                    "status": {k: r.status for k, r in tuned.items()},
                    "verdicts": [v.__dict__ for v in vs_tuned]}}, indent=2))
-    return summary
+    return rep.text(closing=False)
 
 
 def _jsonable(d: dict) -> dict:
@@ -172,33 +197,46 @@ def _jsonable(d: dict) -> dict:
             for k, vals in d.items()}
 
 
-def _tuned_summary(runs, full, steady, vs, window) -> str:
+def _shown_scenario(res: Result) -> dict:
+    """The resolved scenario of a run without the controller's drawn internals (RBF centres...)."""
+    return {k: v for k, v in res.scenario.items() if k != "resolved"}
+
+
+def _status_lines(runs: dict[str, Result], suffix: str = "") -> list[str]:
+    lines = []
+    for label, r in runs.items():
+        line = f"{label}{suffix}: status **{r.status}**"
+        if r.failure:
+            line += f" (t = {r.failure['time']:.4g} s, {r.failure['cause']}: {r.failure['detail']})"
+        lines.append(line)
+    return lines
+
+
+def _tuned_report(rep: Report, runs: dict[str, Result], vs: list[Verdict]) -> None:
     """The claims again, with both controllers tuned by the same procedure (docs/tuning.md)."""
-    lines = ["## The same claims under fair tuning", "",
-             "Both controllers with the gains of one optimiser, budget and objective "
-             f"(gain presets {', '.join(f'`{p}`' for p in TUNED_PRESETS.values())}; docs/tuning.md). "
-             "Run folders: `tuned/`.", ""]
-    for label, r in runs.items():
-        line = f"- {label} (tuned): status **{r.status}**"
-        if r.failure:
-            line += f" (t = {r.failure['time']:.4g} s, {r.failure['cause']}: {r.failure['detail']})"
-        lines.append(line)
-    lines += [""] + [f"- **{v.claim}**: {v.verdict}. {v.evidence}" for v in vs] + [""]
-    return "\n".join(lines)
+    rep.heading("The same claims under fair tuning")
+    rep.paragraph("Both controllers with the gains of one optimiser, budget and objective "
+                  f"(gain presets {', '.join(f'`{p}`' for p in TUNED_PRESETS.values())}; docs/tuning.md). "
+                  "Run folders: `tuned/`.")
+    rep.bullets(_status_lines(runs, " (tuned)"))
+    rep.verdicts([(v.claim, v.verdict, v.evidence) for v in vs])
 
 
-def _summary(runs, full, steady, vs, window) -> str:
-    lines = ["# Section 4 reproduction", ""]
-    for label, r in runs.items():
-        line = f"- {label}: status **{r.status}**"
-        if r.failure:
-            line += f" (t = {r.failure['time']:.4g} s, {r.failure['cause']}: {r.failure['detail']})"
-        lines.append(line)
-    for label, r in runs.items():
-        for note in r.meta.get("notes", []):
-            lines.append(f"- note ({label}): {note}")
-    lines += ["", "## The paper's claims", ""]
-    lines += [f"- **{v.claim}**: {v.verdict}. {v.evidence}" for v in vs]
-    lines += ["", "## Metrics", "", _table(full, steady, window), "",
-              "Figures: `figures/fig3_trajectory3d` … `figures/fig8_chi` (PNG and PDF).", ""]
-    return "\n".join(lines)
+def _report(out: Path, runs, full, steady, vs, window) -> Report:
+    rep = Report(out, "Section 4 reproduction")
+    notes = [f"note ({label}): {note}" for label, r in runs.items() for note in r.meta.get("notes", [])]
+    rep.bullets(_status_lines(runs) + notes)
+    rep.heading("The paper's claims")
+    rep.verdicts([(v.claim, v.verdict, v.evidence) for v in vs])
+    rep.heading("Metrics")
+    rep.table(["metric", "window", "FXTNTSMC", "FTSMC"], _table_rows(full, steady, window))
+    return rep
+
+
+def _figures(rep: Report, runs: dict[str, Result], window: tuple[float, float]) -> None:
+    rep.heading("Figures")
+    rep.paragraph("Files: `figures/fig3_trajectory3d` … `figures/fig8_chi` (PNG and PDF).")
+    ell = plotting.lever_arm(next(iter(runs.values())))
+    for name, _ in FIGURES:
+        rep.image(rep.out / "figures" / f"{name}.png",
+                  CAPTIONS[name].format(ell="?" if ell is None else f"{ell:g} m", t_ss=window[0]))

@@ -31,7 +31,7 @@ from ..scenario import load_scenario
 from ..simulation.api import prepare
 from ..runner.batch import run_batch
 from .registry import StudySpec
-from .report import failure_cause, write_json
+from .report import Report, failure_cause, write_json
 
 __all__ = ["Sample", "RobustnessConfig", "CONTROLLERS", "draw_samples", "sample_scenario",
            "run_batch", "summarise", "run", "STUDY"]
@@ -244,24 +244,22 @@ def _fmt(x: float) -> str:
     return "inf" if math.isinf(x) else f"{x:.3g}"
 
 
-def _report(summary: dict, cfg: RobustnessConfig, quick: bool, wall: float, skipped: list[str]) -> str:
-    lines = ["# Robustness: Monte Carlo over model error, disturbance and initial state", ""]
+def _report(out: Path, summary: dict, cfg: RobustnessConfig, quick: bool, wall: float, skipped: list[str]) -> Report:
+    rep = Report(out, "Robustness: Monte Carlo over model error, disturbance and initial state")
     if quick:
-        lines += ["**Quick mode** (CI smoke test): a handful of short runs; the numbers are not meaningful.", ""]
-    lines += [f"{cfg.n} samples per vehicle (seed {cfg.seed}), {cfg.duration:g} s runs at dt = {cfg.dt:g} s, "
-              f"the same samples for every controller. Draws (uniform): M, D, C model errors in ±{MODEL_ERROR:.0%}; "
-              f"disturbance amplitude in [{AMPLITUDE[0]:g}, {AMPLITUDE[1]:g}] × the paper's, phase in [0, 2π); "
-              "initial x, y ± 1 m, z ± 0.5 m, ψ ± 0.3 rad around Section 4's start; scenario seed = sample index. "
-              f"Wall time {wall:.0f} s.", ""]
+        rep.paragraph("**Quick mode** (CI smoke test): a handful of short runs; the numbers are not meaningful.")
+    rep.paragraph(f"{cfg.n} samples per vehicle (seed {cfg.seed}), {cfg.duration:g} s runs at dt = {cfg.dt:g} s, "
+                  f"the same samples for every controller. Draws (uniform): M, D, C model errors in ±{MODEL_ERROR:.0%}; "
+                  f"disturbance amplitude in [{AMPLITUDE[0]:g}, {AMPLITUDE[1]:g}] × the paper's, phase in [0, 2π); "
+                  "initial x, y ± 1 m, z ± 0.5 m, ψ ± 0.3 rad around Section 4's start; scenario seed = sample index. "
+                  f"Wall time {wall:.0f} s.")
     if skipped:
-        lines += [f"Skipped (gain preset not installed): {', '.join(skipped)}.", ""]
-    lines += ["Quantiles are over the runs that did not fail; `inf` settling = never stayed within 1 cm "
-              "(the count is given as n_inf).", ""]
+        rep.paragraph(f"Skipped (gain preset not installed): {', '.join(skipped)}.")
+    rep.paragraph("Quantiles are over the runs that did not fail; `inf` settling = never stayed within 1 cm "
+                  "(the count is given as n_inf).")
     for vehicle, per in summary.items():
-        lines += [f"## Vehicle `{vehicle}`", "",
-                  "| controller | failure rate | failures by cause | "
-                  + " | ".join(f"{q} median / p95" for q, _ in QUANTITIES) + " |",
-                  "|---|---|---|" + "---|" * len(QUANTITIES)]
+        rep.heading(f"Vehicle `{vehicle}`")
+        rows = []
         for label, s in per.items():
             causes = ", ".join(f"{c}: {k}" for c, k in sorted(s["causes"].items())) or "none"
             cells = []
@@ -270,16 +268,16 @@ def _report(summary: dict, cfg: RobustnessConfig, quick: bool, wall: float, skip
                 if s[q]["n_inf"]:
                     cell += f" (n_inf {s[q]['n_inf']})"
                 cells.append(cell)
-            lines.append(f"| {label} | {s['failed']}/{s['n']} ({s['failure_rate']:.0%}) | {causes} | "
-                         + " | ".join(cells) + " |")
-        lines.append("")
-    lines += ["Quantities: " + "; ".join(f"`{q}` = {d}" for q, d in QUANTITIES) + ".", ""]
-    return "\n".join(lines)
+            rows.append([label, f"{s['failed']}/{s['n']} ({s['failure_rate']:.0%})", causes, *cells])
+        rep.table(["controller", "failure rate", "failures by cause", *(f"{q} median / p95" for q, _ in QUANTITIES)],
+                  rows)
+    rep.paragraph("Quantities: " + "; ".join(f"`{q}` = {d}" for q, d in QUANTITIES) + ".")
+    return rep
 
 
 def run(out: Path, *, quick: bool = False, progress: bool = False,
         config: RobustnessConfig | None = None) -> Path:
-    """Run the Monte Carlo study and write ``report.md``, ``runs.csv`` and ``results.json``.
+    """Run the Monte Carlo study and write ``report.md``, ``report.html``, ``runs.csv`` and ``results.json``.
 
     Parameters
     ----------
@@ -330,9 +328,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False,
     df.to_csv(out / "runs.csv", index=False)
     write_json(out / "results.json", (
         {"config": asdict(cfg), "quick": quick, "controllers": controllers, "summary": summary}))
-    report = out / "report.md"
-    report.write_text(_report(summary, cfg, quick, wall, skipped))
-    return report
+    return _report(out, summary, cfg, quick, wall, skipped).write()
 
 
 STUDY = StudySpec("robustness", run, "Monte Carlo over +-30 % model error, disturbance amplitude/phase and "

@@ -35,7 +35,7 @@ from ..control.theory import check_theorem1
 from ..scenario import load_scenario
 from ..simulation.api import prepare, run_prepared
 from .registry import StudySpec
-from .report import write_json
+from .report import Report, write_json
 
 __all__ = ["GainSpace", "Objective", "Case", "Budget", "SPACES", "TRAIN_CASES", "HELDOUT_CASES",
            "case_scenario", "run_cost", "tune", "evaluate", "preset_toml", "run", "STUDY"]
@@ -480,44 +480,40 @@ def _fmt(x: float) -> str:
     return "inf" if not math.isfinite(x) else f"{x:.4g}"
 
 
-def _report(results: dict[str, TuneResult], evals: dict, budget: Budget, objective: Objective,
-            quick: bool, heldout: Sequence[Case]) -> str:
-    lines = ["# Fair tuning: FTSMC vs FXTNTSMC", ""]
+def _report(out: Path, results: dict[str, TuneResult], evals: dict, budget: Budget, objective: Objective,
+            quick: bool, heldout: Sequence[Case]) -> Report:
+    rep = Report(out, "Fair tuning: FTSMC vs FXTNTSMC")
     if quick:
-        lines += ["**Quick mode** (CI smoke test): tiny budget, short runs; the numbers are not meaningful.", ""]
-    lines += [f"Optimiser: SciPy differential_evolution, seed {budget.seed}, popsize {budget.popsize} "
-              f"(x 4 gains), maxiter {budget.maxiter}, polish off, the package defaults as first candidate. "
-              f"Training: {', '.join(c.name for c in TRAIN_CASES[: budget.n_train])} "
-              f"({budget.duration:g} s, dt {budget.dt:g} s). Held-out: "
-              f"{', '.join(c.name for c in heldout)} ({budget.heldout_duration:g} s).",
-              "",
-              f"Objective per run: {objective.w_itae:g} ΣITAE + {objective.w_energy:g} Σ∫τ²dt + "
-              f"{objective.w_tv:g} ΣTV(τ)/s; failure {objective.penalty:g}(2 − t_fail/T). Mean over scenarios.",
-              "", "## Tuned gains", "", "| controller | gains (default → tuned) | evaluations | wall (s) |",
-              "|---|---|---|---|"]
+        rep.paragraph("**Quick mode** (CI smoke test): tiny budget, short runs; the numbers are not meaningful.")
+    rep.paragraph(f"Optimiser: SciPy differential_evolution, seed {budget.seed}, popsize {budget.popsize} "
+                  f"(x 4 gains), maxiter {budget.maxiter}, polish off, the package defaults as first candidate. "
+                  f"Training: {', '.join(c.name for c in TRAIN_CASES[: budget.n_train])} "
+                  f"({budget.duration:g} s, dt {budget.dt:g} s). Held-out: "
+                  f"{', '.join(c.name for c in heldout)} ({budget.heldout_duration:g} s).")
+    rep.paragraph(f"Objective per run: {objective.w_itae:g} ΣITAE + {objective.w_energy:g} Σ∫τ²dt + "
+                  f"{objective.w_tv:g} ΣTV(τ)/s; failure {objective.penalty:g}(2 − t_fail/T). Mean over scenarios.")
+    rep.heading("Tuned gains")
+    rows = []
     for kind, r in results.items():
         g = ", ".join(f"{k} {r.start_gains[k]:.4g} → {v:.4g}" for k, v in r.gains.items())
-        lines.append(f"| {kind} | {g} | {r.nfev} | {r.wall_s:.1f} |")
-    lines += ["", "## Objective (mean J; lower is better)", "",
-              "| controller | gains | training | held-out | " + " | ".join(evals["columns"]) + " |",
-              "|---|---|---|---|" + "---|" * len(evals["columns"])]
-    for row in evals["rows"]:
-        lines.append(f"| {row['kind']} | {row['gains']} | {_fmt(row['train'])} | {_fmt(row['heldout'])} | "
-                     + " | ".join(_fmt(x) for x in row["per_case"]) + " |")
-    lines += ["", "## Held-out runs in detail", "",
-              "| controller | gains | case | status | J | ITAE x/y/z | RMSE x/y/z (m) | TV τ u/q/r |",
-              "|---|---|---|---|---|---|---|---|"]
+        rows.append([kind, g, r.nfev, f"{r.wall_s:.1f}"])
+    rep.table(["controller", "gains (default → tuned)", "evaluations", "wall (s)"], rows)
+    rep.heading("Objective (mean J; lower is better)")
+    rep.table(["controller", "gains", "training", "held-out", *evals["columns"]],
+              [[row["kind"], row["gains"], _fmt(row["train"]), _fmt(row["heldout"]), *(_fmt(x) for x in row["per_case"])]
+               for row in evals["rows"]])
+    rep.heading("Held-out runs in detail")
+    rows = []
     for row in evals["rows"]:
         for rec in row["records"]:
             m = rec["metrics"]
             st = rec["status"] if rec["failure"] is None else \
                 f"failed ({rec['failure']['cause']} at {rec['failure']['time']:.3g} s)"
-            lines.append(f"| {row['kind']} | {row['gains']} | {rec['case']} | {st} | {_fmt(rec['J'])} | "
-                         + "/".join(_fmt(m[f'itae_{a}']) for a in AXES) + " | "
-                         + "/".join(_fmt(m[f'rmse_{a}']) for a in AXES) + " | "
-                         + "/".join(_fmt(m[f'tv_tau_{j}']) for j in INPUTS) + " |")
-    lines.append("")
-    return "\n".join(lines)
+            rows.append([row["kind"], row["gains"], rec["case"], st, _fmt(rec["J"]),
+                         "/".join(_fmt(m[f"itae_{a}"]) for a in AXES), "/".join(_fmt(m[f"rmse_{a}"]) for a in AXES),
+                         "/".join(_fmt(m[f"tv_tau_{j}"]) for j in INPUTS)])
+    rep.table(["controller", "gains", "case", "status", "J", "ITAE x/y/z", "RMSE x/y/z (m)", "TV τ u/q/r"], rows)
+    return rep
 
 
 def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
@@ -526,7 +522,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     Parameters
     ----------
     out : pathlib.Path
-        Output folder (created): ``report.md``, ``results.json``, ``ftsmc_tuned.toml`` and
+        Output folder (created): ``report.md``, ``report.html``, ``results.json``, ``ftsmc_tuned.toml`` and
         ``fxtntsmc_tuned.toml`` (copy them to ``auvtrack/data/gains/`` to update the presets).
     quick : bool, optional
         CI smoke test: 16 evaluations of one 4 s scenario per controller.
@@ -566,9 +562,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
         {"budget": asdict(budget), "objective": asdict(objective), "quick": quick,
          "train_cases": [asdict(c) for c in train], "heldout_cases": [asdict(c) for c in heldout],
          "results": {k: asdict(r) for k, r in results.items()}, "evaluation": rows}))
-    report = out / "report.md"
-    report.write_text(_report(results, evals, budget, objective, quick, heldout))
-    return report
+    return _report(out, results, evals, budget, objective, quick, heldout).write()
 
 
 STUDY = StudySpec("tuning", run, "fair tuning of FTSMC and FXTNTSMC: same optimiser, budget, objective; "
