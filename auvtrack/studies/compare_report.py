@@ -331,6 +331,8 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
                   f"{timing['runs_seconds']:.1f} s ({timing['backend']}, {timing['chunks_run']} chunks run now, "
                   f"{timing['chunks_resumed']} resumed), on {platform.machine()} / Python "
                   f"{platform.python_version()}.")
+    rep.scenario(suite.text or suite.settings(), f"Suite `{suite.name}` ({suite.source}): every task, tier and "
+                 "setting of the runs (each run's scenario: `auvtrack.studies.suite.Suite.scenario`)")
     report = rep.write()
     timing = dict(timing, analysis_seconds=time.perf_counter() - t_analysis0)
     write_json(out / "results.json", {

@@ -294,7 +294,7 @@ def rank_bootstrap(df, weights: Mapping[str, float], *, seed: int, n_resamples: 
     return out
 
 
-def paired_comparisons(df, *, criteria: Sequence[str] = CRITERIA) -> list[dict]:
+def paired_comparisons(df, *, criteria: Sequence[str] = CRITERIA, controllers: Sequence[str] | None = None) -> list[dict]:
     """Every pair of controllers in every tier, on the same (task, seed index) pairs.
 
     For each metric: the Wilcoxon signed-rank test (p-value, rank-biserial correlation) and the
@@ -307,6 +307,8 @@ def paired_comparisons(df, *, criteria: Sequence[str] = CRITERIA) -> list[dict]:
         Runs with the derived metrics.
     criteria : sequence of str, optional
         ``failure`` and/or metric names.
+    controllers : sequence of str, optional
+        Order of the controllers (pair ``(a, b)`` has ``a`` first); default: first appearance in ``df``.
 
     Returns
     -------
@@ -316,7 +318,7 @@ def paired_comparisons(df, *, criteria: Sequence[str] = CRITERIA) -> list[dict]:
         ``n_less`` count for ``a`` being better (smaller).
     """
     out: list[dict] = []
-    controllers = list(dict.fromkeys(df["controller"]))
+    controllers = list(controllers) if controllers is not None else list(dict.fromkeys(df["controller"]))
     for tier, g in df.groupby("tier", sort=False):
         wide = {c: gc.set_index(["task", "seed_index"]).sort_index() for c, gc in g.groupby("controller", sort=False)}
         family: dict[tuple[str, str], list[dict]] = {}

@@ -339,11 +339,14 @@ class Suite:
         Where it came from (for messages and the report).
     quick : bool
         The ``--quick`` variant (:meth:`quick_variant`).
+    text : str
+        The suite file as written (shown in the report).
     """
 
     file: SuiteFile
     source: str = "<suite>"
     quick: bool = False
+    text: str = field(default="", repr=False)
     _skipped: tuple[tuple[str, str], ...] = field(default=(), repr=False)
 
     # ---------------------------------------------------------------- shape
@@ -480,6 +483,8 @@ def _check_runs(suite: Suite) -> None:
     for task in suite.tasks:
         for tier in suite.tiers:
             raw, ov, _ = suite.scenario(entry, task, tier, 0)
+            tr = suite.file.tiers[tier]
+            ov = {k: v for k, v in ov.items() if k not in tr.random}  # the random keys probed one by one
             probes = [("set", ov)]
             for key, dist in suite.file.tiers[tier].random.items():
                 for end in dist.probes():
@@ -519,27 +524,28 @@ def load_suite(name: str | Path = DEFAULT_SUITE, *, check: bool = True) -> Suite
     from ..plant import PLANTS
     from ..scenario.loader import read_toml
 
-    text = str(name)
-    if text in available_suites():
-        path, source = Path(str(_suites_root() / f"{text}.toml")), text
-    elif text.endswith(".toml"):
-        path, source = Path(text), text
+    label = str(name)
+    if label in available_suites():
+        path, source = Path(str(_suites_root() / f"{label}.toml")), label
+    elif label.endswith(".toml"):
+        path, source = Path(label), label
     else:
-        raise SuiteError(f"--suite: unknown suite {text!r} (shipped: {', '.join(available_suites()) or 'none'}; "
+        raise SuiteError(f"--suite: unknown suite {label!r} (shipped: {', '.join(available_suites()) or 'none'}; "
                          "or a path to a .toml file)")
     try:
         raw = read_toml(path)
+        text = path.read_text(encoding="utf-8")
     except ScenarioError as exc:
         raise SuiteError(str(exc)) from None
     try:
         sf = SuiteFile.model_validate(raw)
     except ValidationError as exc:
         err = translate(exc, SuiteFile, source)
-        text = re.sub(r"\.(?:uniform|normal|loguniform)(?=[.:])", "", str(err), count=1)
-        raise SuiteError(text, err.path) from None
+        msg = re.sub(r"\.(?:uniform|normal|loguniform)(?=[.:])", "", str(err), count=1)
+        raise SuiteError(msg, err.path) from None
     skipped = tuple((t, f"plant model {tr.requires_plant!r} is not available in this build")
                     for t, tr in sf.tiers.items() if tr.requires_plant and tr.requires_plant not in PLANTS)
-    suite = Suite(sf, source, False, skipped)
+    suite = Suite(sf, source, False, text, skipped)
     if not suite.tiers:
         raise SuiteError(f"{source}: tiers: none can run in this build ({'; '.join(r for _, r in skipped)})")
     if check:

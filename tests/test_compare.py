@@ -1,0 +1,200 @@
+"""``auvtrack compare`` end to end: the quick path, determinism, resume, Dask, a failing controller, bad input."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from auvtrack.cli import EXIT_BAD_INPUT, main
+from auvtrack.runner import compare as runner
+from auvtrack.studies.benchmark import compare
+from auvtrack.studies.suite import (ControllerEntry, SuiteError, load_suite, resolve_controllers, tracking_kinds)
+from report_check import check_html_report
+
+TINY = """
+name = "tiny"
+version = 1
+seed = 5
+seeds = 3
+bootstrap_resamples = 200
+[base]
+"vehicle.preset" = "remus100"
+"sim.dt" = 0.002
+"disturbance" = []
+[quick]
+seeds = 2
+duration = 1.0
+[tasks.helix]
+duration = 3.0
+reference = { kind = "helix", radius = 10.0, omega = 0.1, climb = -0.25, center = [0.0, 0.0, 20.0] }
+[tasks.line]
+duration = 2.0
+reference = { kind = "line", start = [0.0, 0.0, 5.0], velocity = [1.0, 0.0, 0.0] }
+[tiers.calm]
+start = { lateral = 0.3 }
+[tiers.model]
+start = { lateral = 1.0, heading = 0.2 }
+[tiers.model.random]
+"uncertainty.M" = { dist = "uniform", low = -0.2, high = 0.2 }
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("suite") / "tiny.toml"
+    path.write_text(TINY)
+    return path
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    """``auvtrack compare --quick`` through the command line, once for the module."""
+    out = tmp_path_factory.mktemp("quick") / "q"
+    assert main(["compare", "--quick", "--out", str(out), "--quiet"]) == 0
+    return out
+
+
+def _results(out: Path) -> dict:
+    doc = json.loads((out / "results.json").read_text())
+    doc.pop("timing")
+    return doc
+
+
+def test_quick_path_every_controller_and_tier_and_the_report_files(quick):
+    suite = load_suite().quick_variant()
+    doc = json.loads((quick / "results.json").read_text())
+    kinds = tracking_kinds()
+    assert sorted(r["controller"] for r in doc["leaderboard"]) == sorted(kinds)
+    assert {c["tier"] for c in doc["cells"]} == set(suite.tiers)
+    assert {c["task"] for c in doc["cells"]} == set(suite.tasks)
+    assert len(doc["cells"]) == len(kinds) * len(suite.tasks) * len(suite.tiers)
+    runs = pd.read_parquet(quick / "runs.parquet")
+    assert len(runs) == len(kinds) * len(suite.tasks) * len(suite.tiers) * suite.seeds
+    assert set(runs["controller"]) == set(kinds) and set(runs["tier"]) == set(suite.tiers)
+    md = (quick / "report.md").read_text()
+    for name in kinds + suite.tiers:
+        assert name in md
+    for t in suite.skipped_tiers:
+        assert f"`{t}`" in md  # a tier this build cannot run is named, with the reason
+    for fig in ["leaderboard", "failure_rates", *(f"dist_{m}" for m in ("rmse", "tv")), "traj_helix"]:
+        assert (quick / "figures" / f"{fig}.png").is_file()
+    html = check_html_report(quick)
+    assert "Leaderboard" in html and suite.name in html
+    assert doc["suite"]["name"] == "auv-track-v1" and doc["suite"]["quick"] is True
+    assert doc["auvtrack_version"] and len(doc["source_hash"]) == 64
+
+
+def test_quick_path_numbers_are_the_runs_numbers(quick):
+    """A row of runs.parquet is the single-run result of its scenario (the batch runner's guarantee)."""
+    from auvtrack.scenario import load_scenario
+    from auvtrack.simulation.api import simulate
+
+    runs = pd.read_parquet(quick / "runs.parquet")
+    suite = load_suite().quick_variant()
+    entries = {e.label: e for e in resolve_controllers()}
+    row = runs.iloc[len(runs) // 3]
+    raw, ov, drawn = suite.scenario(entries[row.controller], row.task, row.tier, int(row.seed_index))
+    res = simulate(load_scenario(raw, ov))
+    assert res.status == row.status
+    for m in ("rmse_x", "itae_z", "energy_tau_u", "tv_tau_r", "settle_5cm_y"):
+        assert res.metrics[m] == row[m] or (math.isnan(res.metrics[m]) and math.isnan(row[m]))
+    assert json.loads(row.draws) == pytest.approx(drawn)
+
+
+def test_same_suite_same_seeds_identical_numbers(tiny, tmp_path):
+    a = compare(tiny, out=tmp_path / "a", progress=False)
+    b = compare(tiny, out=tmp_path / "b", progress=False, chunk_size=5)  # chunking must not matter
+    assert a.complete and b.complete
+    assert _results(tmp_path / "a") == _results(tmp_path / "b")
+    ra, rb = pd.read_parquet(tmp_path / "a" / "runs.parquet"), pd.read_parquet(tmp_path / "b" / "runs.parquet")
+    pd.testing.assert_frame_equal(ra, rb)
+    # every controller met the same conditions: seeds and draws do not depend on the controller
+    per = ra.groupby(["tier", "task", "seed_index"])
+    assert (per["seed"].nunique() == 1).all() and (per["draws"].nunique() == 1).all()
+    # the start offsets' unit draws are shared by the tiers (scaled by each tier's half-width)
+    d = ra.assign(lat=ra["draws"].map(lambda s: json.loads(s)["start.lateral"]))
+    calm = d[d.tier == "calm"].set_index(["task", "seed_index", "controller"])["lat"]
+    model = d[d.tier == "model"].set_index(["task", "seed_index", "controller"])["lat"]
+    np.testing.assert_allclose(model.sort_index().to_numpy(), calm.sort_index().to_numpy() / 0.3, rtol=1e-12)
+
+
+def test_interrupted_comparison_resumes_to_identical_numbers(tiny, tmp_path):
+    ref = compare(tiny, out=tmp_path / "ref", progress=False, chunk_size=4)
+    part = compare(tiny, out=tmp_path / "part", progress=False, chunk_size=4, max_chunks=2)
+    assert not part.complete and part.execution.chunks_run == 2
+    with pytest.raises(runner.CompareError, match="--resume"):
+        compare(tiny, out=tmp_path / "part", progress=False, chunk_size=4)
+    done = compare(tiny, out=tmp_path / "part", progress=False, chunk_size=4, resume=True)
+    assert done.complete and done.execution.chunks_skipped == 2
+    assert _results(tmp_path / "part") == _results(tmp_path / "ref")
+    with pytest.raises(runner.CompareError, match="another comparison"):
+        compare(tiny, out=tmp_path / "part", progress=False, chunk_size=4, controllers=["ftsmc"], resume=True)
+
+
+def test_a_failing_controller_is_ranked_not_dropped(tiny, tmp_path):
+    entries = resolve_controllers(["ftsmc"]) + [
+        ControllerEntry("crash", {"kind": "open_loop", "tau0": [0.0, 300.0, 0.0]}, "open loop: 300 N m pitch")]
+    res = compare(tiny, out=tmp_path / "f", progress=False, entries=entries)
+    doc = json.loads((tmp_path / "f" / "results.json").read_text())
+    board = [r["controller"] for r in doc["leaderboard"]]
+    assert board == ["ftsmc", "crash"]
+    crash = next(r for r in doc["pooled"] if r["controller"] == "crash")
+    assert crash["failure_rate"] == 1.0 and crash["causes"] and crash["failure_ci"][0] > 0.5
+    cells = [c for c in doc["cells"] if c["controller"] == "crash"]
+    assert len(cells) == 4 and all(c["rmse"]["median"] is None for c in cells)  # inf in strict JSON
+    assert "crash" in res.report.read_text()
+
+
+def test_dask_scheduler_gives_the_local_numbers(tiny, tmp_path):
+    from distributed import Client, LocalCluster
+
+    local = compare(tiny, out=tmp_path / "local", progress=False, quick=True)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster, \
+            Client(cluster) as client:
+        dask = compare(tiny, out=tmp_path / "dask", progress=False, quick=True, client=client)
+    assert local.complete and dask.complete
+    pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "local" / "runs.parquet"),
+                                  pd.read_parquet(tmp_path / "dask" / "runs.parquet"))
+
+
+def test_plan_is_every_controller_task_tier_and_seed(tiny):
+    suite = load_suite(tiny)
+    entries = resolve_controllers()
+    specs = runner.plan_runs(suite, entries)
+    assert len(specs) == len(entries) * 2 * 2 * 3
+    assert {(s.controller, s.task, s.tier, s.index) for s in specs} == {
+        (e.label, k, t, i) for e in entries for k in suite.tasks for t in suite.tiers for i in range(3)}
+    q = suite.quick_variant()
+    assert q.seeds == 2 and q.duration("helix") == 1.0 and q.fingerprint() != suite.fingerprint()
+
+
+@pytest.mark.parametrize("args, expect", [
+    (["--suite", "nope"], "--suite: unknown suite 'nope'"),
+    (["--controllers", "pid2"], "--controllers: unknown controller 'pid2'"),
+    (["--plugin", "missing.py"], "--plugin: must be an existing .py file"),
+    (["--workers", "0"], "--workers: must be >= 1"),
+])
+def test_bad_options_exit_2_with_one_line(args, expect, tmp_path, capsys):
+    assert main(["compare", "--out", str(tmp_path / "x"), "--quiet", *args]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("auvtrack: error: ") and expect in err and "\n" not in err
+
+
+@pytest.mark.parametrize("old, new, expect", [
+    ("seeds = 3", "seeds = 0", "seeds: must be >= 1"),
+    ('[tiers.calm]', '[tiers.calm]\nbogus = 1', "tiers.calm.bogus: unknown key"),
+    ('"uncertainty.M" = { dist = "uniform", low = -0.2, high = 0.2 }',
+     '"uncertainty.M" = { dist = "uniform", low = -0.2, high = 5.0 }', "tiers.model.random.uncertainty.M"),
+    ("duration = 2.0", "duration = -2.0", "tasks.line.duration: must be > 0"),
+])
+def test_invalid_suite_file_one_line(tmp_path, old, new, expect):
+    path = tmp_path / "bad.toml"
+    assert old in TINY
+    path.write_text(TINY.replace(old, new, 1))
+    with pytest.raises(SuiteError) as info:
+        load_suite(path)
+    assert expect in str(info.value) and "\n" not in str(info.value)
