@@ -198,3 +198,13 @@ def test_invalid_suite_file_one_line(tmp_path, old, new, expect):
     with pytest.raises(SuiteError) as info:
         load_suite(path)
     assert expect in str(info.value) and "\n" not in str(info.value)
+
+
+def test_shipped_suite_is_sized_for_its_failure_interval():
+    """auv-track-v1: a ±5 % failure-rate interval per controller and tier, whatever the rate; a cell without
+    failure bounded below 5 %."""
+    suite = load_suite()
+    h = suite.failure_halfwidths()
+    assert h["tier"] <= suite.file.failure_halfwidth and h["zero_failures"] <= suite.file.failure_halfwidth
+    assert set(suite.file.tiers) == {"ideal", "digital", "ocean", "model", "truth6"}
+    assert set(suite.tasks) == {"helix", "circle", "lawnmower", "waypoints"}

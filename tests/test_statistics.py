@@ -177,3 +177,11 @@ def test_holm_hand_example():
 
 def test_average_ranks_ties_and_infinities():
     assert st.average_ranks([0.2, np.inf, 0.1, np.nan, 0.2]).tolist() == [2.5, 4.5, 1.0, 4.5, 2.5]
+
+
+@pytest.mark.parametrize("n", [1, 7, 100, 400])
+def test_wilson_halfwidth_max_is_the_worst_count(n):
+    widths = [(hi - lo) / 2 for lo, hi in (wilson_closed_form(k, n) for k in range(n + 1))]
+    assert st.wilson_halfwidth_max(n) == pytest.approx(max(widths), rel=1e-12)
+    # the worst case is the middle count, and it shrinks like 1 / sqrt(n)
+    assert max(widths) == pytest.approx(widths[n // 2], rel=1e-12)

@@ -304,6 +304,7 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
     Returns
     -------
     ExecOutcome
+        Whether every chunk is on disk (``runs.parquet`` is then written), chunks run and resumed, timing.
 
     Raises
     ------

@@ -174,6 +174,7 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     Returns
     -------
     CompareOutcome
+        The folder, whether it is complete (``report`` is then ``report.md``) and the timing.
     """
     from .compare_report import write_report
 

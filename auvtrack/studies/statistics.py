@@ -37,7 +37,7 @@ from typing import Sequence
 
 import numpy as np
 
-__all__ = ["wilson_interval", "median", "bootstrap_median", "MedianEstimate", "PairedTest", "wilcoxon_test",
+__all__ = ["wilson_interval", "wilson_halfwidth_max", "median", "bootstrap_median", "MedianEstimate", "PairedTest", "wilcoxon_test",
            "sign_test", "rank_biserial", "holm", "average_ranks", "rank_preserving_differences"]
 
 
@@ -73,6 +73,25 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
         raise ValueError(f"confidence: must be in (0, 1) (got {confidence})")
     ci = binomtest(int(k), int(n)).proportion_ci(confidence_level=confidence, method="wilson")
     return float(ci.low), float(ci.high)
+
+
+def wilson_halfwidth_max(n: int, confidence: float = 0.95) -> float:
+    """Largest half-width ``(high - low) / 2`` of the Wilson interval over every count ``k`` of ``n`` trials.
+
+    Parameters
+    ----------
+    n : int
+        Trials, >= 1.
+    confidence : float, optional
+        Level.
+
+    Returns
+    -------
+    float
+        The worst case (reached near ``k = n / 2``): how many runs a failure-rate interval of a
+        given width needs, whatever the rate turns out to be.
+    """
+    return max((hi - lo) / 2.0 for lo, hi in (wilson_interval(k, n, confidence) for k in range(n // 2 + 1)))
 
 
 def _clean(x: Sequence[float]) -> np.ndarray:
@@ -149,6 +168,7 @@ def bootstrap_median(x: Sequence[float], rng: np.random.Generator, *, confidence
     Returns
     -------
     MedianEstimate
+        The median, the interval's bounds, the sample size and the level.
     """
     a = _clean(x)
     n = a.size

@@ -256,6 +256,7 @@ def resolve_controllers(names: list[str] | None = None, plugins: list[str | Path
     Returns
     -------
     list of ControllerEntry
+        Built-ins first (in ``names`` or registration order), then the plug-ins.
 
     Raises
     ------
@@ -386,6 +387,23 @@ class Suite:
         d = self.file.tasks[task].duration
         return min(d, self.file.quick.duration) if self.quick else d
 
+    def failure_halfwidths(self) -> dict[str, float]:
+        """Worst-case Wilson half-widths of the failure rates: per cell and per (controller, tier).
+
+        Returns
+        -------
+        dict
+            ``cell`` (``seeds`` runs), ``tier`` (``seeds x tasks`` runs, the level the tier ranks
+            and the failure figure pool) and ``zero_failures`` (the upper bound of a cell with no
+            failure).
+        """
+        from .statistics import wilson_halfwidth_max, wilson_interval
+
+        c = self.file.confidence
+        return {"cell": wilson_halfwidth_max(self.seeds, c),
+                "tier": wilson_halfwidth_max(self.seeds * len(self.tasks), c),
+                "zero_failures": wilson_interval(0, self.seeds, c)[1]}
+
     def quick_variant(self) -> "Suite":
         """The ``--quick`` suite: every task and tier, few seeds, short runs."""
         return replace(self, quick=True)
@@ -456,6 +474,7 @@ class Suite:
                 "quick": self.quick, "seed": self.file.seed, "seeds": self.seeds,
                 "durations": {t: self.duration(t) for t in self.tasks},
                 "bootstrap_resamples": self.bootstrap_resamples, "skipped_tiers": self.skipped_tiers,
+                "failure_halfwidths": self.failure_halfwidths(),
                 "file": self.file.model_dump(mode="json")}
 
 
