@@ -273,9 +273,19 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
         raise BadInput(f"--workers: must be >= 1 (got {workers})")
     try:
         suite = load_suite(suite_name)
-        if quick:
-            suite = suite.quick_variant()
-        folder = Path(out) if out else default_out(suite)
+    except SuiteError as exc:
+        raise BadInput(_one_line(exc)) from None
+    if quick:
+        suite = suite.quick_variant()
+    folder = Path(out) if out else default_out(suite)
+
+    def _stop(signum, frame):  # SIGTERM as Ctrl-C: stop cleanly, the finished chunks stay for --resume
+        raise KeyboardInterrupt
+
+    import signal
+
+    previous = signal.signal(signal.SIGTERM, _stop)
+    try:
         res = _compare(suite, controllers=_split_names(controllers) or None, plugins=list(plugins), out=folder,
                        scheduler=scheduler, workers=workers, resume=resume, max_chunks=max_chunks,
                        progress=not quiet)
@@ -285,6 +295,8 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
         click.echo(f"auvtrack: interrupted; the finished chunks are kept: auvtrack compare --suite {suite_name}"
                    f"{' --quick' if quick else ''} --out {folder} --resume", err=True)
         raise click.exceptions.Exit(130)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     if not res.complete:
         click.echo(f"stopped after {res.execution.chunks_run} chunks; finish with: auvtrack compare --suite "
                    f"{suite_name}{' --quick' if quick else ''} --out {folder} --resume")

@@ -208,3 +208,32 @@ def test_shipped_suite_is_sized_for_its_failure_interval():
     assert h["tier"] <= suite.file.failure_halfwidth and h["zero_failures"] <= suite.file.failure_halfwidth
     assert set(suite.file.tiers) == {"ideal", "digital", "ocean", "model", "truth6"}
     assert set(suite.tasks) == {"helix", "circle", "lawnmower", "waypoints"}
+
+
+def test_ctrl_c_keeps_the_finished_chunks_and_resume_finishes(tiny, tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    path = tmp_path / "long.toml"
+    path.write_text(TINY.replace("seeds = 3", "seeds = 60").replace("duration = 3.0", "duration = 20.0"))
+    out = tmp_path / "c"
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(root))
+    p = subprocess.Popen([sys.executable, "-m", "auvtrack.cli", "compare", "--suite", str(path), "--out", str(out),
+                          "--quiet"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 600
+    while not runner.chunk_path(out, 0).exists() and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=600)
+    assert p.returncode == 130, err
+    assert "--resume" in err and "Traceback" not in err
+    kept = sorted((out / "chunks").glob("chunk-*.parquet"))
+    assert 1 <= len(kept) < 10 and not (out / "runs.parquet").exists()
+    res = compare(path, out=out, progress=False, resume=True)
+    assert res.complete and res.execution.chunks_skipped == len(kept)
+    runs = pd.read_parquet(out / "runs.parquet")
+    assert sorted(runs["run"]) == list(range(len(resolve_controllers()) * 2 * 2 * 60))

@@ -83,8 +83,9 @@ def plan_runs(suite, entries: Sequence) -> list[RunSpec]:
     for tier in suite.tiers:
         for task in suite.tasks:
             for i in range(suite.seeds):
+                cond = suite.conditions(task, tier, i)  # the same for every controller
                 for e in entries:
-                    raw, ov, drawn = suite.scenario(e, task, tier, i)
+                    raw, ov, drawn = suite.scenario(e, task, tier, i, cond)
                     runs.append(RunSpec(len(runs), e.label, task, tier, i, raw, ov, drawn))
     return runs
 

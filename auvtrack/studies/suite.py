@@ -16,6 +16,7 @@ suite and its own (task, tier, index), never on the order, chunking or worker.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -306,9 +307,7 @@ def start_state(reference: dict, start: Start, unit: Mapping[str, float], ell: f
     (list of 5 float, list of 5 float)
         ``initial.eta`` (m, m, m, rad, rad) and ``initial.nu`` (m/s, m/s, m/s, rad/s, rad/s).
     """
-    from ..reference import build_reference
-
-    p, v, _ = build_reference(reference).evaluate(0.0)
+    p, v = _reference_start(json.dumps(reference, sort_keys=True))
     speed = float(np.linalg.norm(v))
     if speed <= 0.0:
         raise SuiteError(f"reference {reference.get('kind')!r}: starts at rest; a task needs a moving reference")
@@ -322,6 +321,17 @@ def start_state(reference: dict, start: Start, unit: Mapping[str, float], ell: f
     d = (math.cos(theta) * math.cos(psi), math.cos(theta) * math.sin(psi), -math.sin(theta))
     eta = [float(target[0] - ell * d[0]), float(target[1] - ell * d[1]), float(target[2] - ell * d[2]), theta, psi]
     return eta, [speed * (1.0 + off["speed"]), 0.0, 0.0, 0.0, 0.0]
+
+
+@functools.lru_cache(maxsize=64)
+def _reference_start(spec: str) -> tuple[np.ndarray, np.ndarray]:
+    """Position and velocity at t = 0 of a reference given as JSON (cached: every run of a task shares it)."""
+    from ..reference import build_reference
+
+    p, v, _ = build_reference(json.loads(spec)).evaluate(0.0)
+    p.setflags(write=False)
+    v.setflags(write=False)
+    return p, v
 
 
 def _generator(seed: int, purpose: str, index: int) -> np.random.Generator:
@@ -427,8 +437,36 @@ class Suite:
             vals[key] = options[index % len(options)]
         return vals
 
-    def scenario(self, entry: ControllerEntry, task: str, tier: str, index: int) -> tuple[dict, dict, dict]:
-        """The scenario of one run.
+    def conditions(self, task: str, tier: str, index: int) -> tuple[dict, dict, dict]:
+        """What one seed index of a (task, tier) cell imposes, whatever the controller.
+
+        Parameters
+        ----------
+        task, tier : str
+            Names from the suite.
+        index : int
+            Seed index, ``0 <= index < seeds``.
+
+        Returns
+        -------
+        (dict, dict, dict)
+            The raw scenario without ``name`` and ``controller``, the overrides to apply on it,
+            and the values this seed drew (start offsets and tier values), for the record.
+        """
+        tk, tr = self.file.tasks[task], self.file.tiers[tier]
+        ell = float(self.file.base.get("vehicle.l", 1.0))
+        unit = self.unit_draws(task, index)
+        eta, nu = start_state(tk.reference, tr.start, unit, ell)
+        raw = {"seed": self.scenario_seed(task, index), "sim": {"duration": self.duration(task)},
+               "reference": dict(tk.reference), "initial": {"eta": eta, "nu": nu}}
+        values = self.tier_values(task, tier, index)
+        overrides = {**self.file.base, **tr.set, **values}
+        drawn = {f"start.{a}": (2.0 * unit[a] - 1.0) * getattr(tr.start, a) + 0.0 for a in START_AXES} | values
+        return raw, overrides, drawn
+
+    def scenario(self, entry: ControllerEntry, task: str, tier: str, index: int,
+                 conditions: tuple[dict, dict, dict] | None = None) -> tuple[dict, dict, dict]:
+        """The scenario of one run: :meth:`conditions` with the controller's table.
 
         Parameters
         ----------
@@ -438,30 +476,18 @@ class Suite:
             Names from the suite.
         index : int
             Seed index, ``0 <= index < seeds``.
+        conditions : tuple, optional
+            ``self.conditions(task, tier, index)`` when already computed.
 
         Returns
         -------
         (dict, dict, dict)
             The raw scenario dict, the overrides to apply on it (``load_scenario(raw,
-            overrides)``) and the values this seed drew (start offsets and tier values), for the
-            record.
+            overrides)``) and the values this seed drew.
         """
-        tk, tr = self.file.tasks[task], self.file.tiers[tier]
-        ell = float(self.file.base.get("vehicle.l", 1.0))
-        unit = self.unit_draws(task, index)
-        eta, nu = start_state(tk.reference, tr.start, unit, ell)
-        raw = {
-            "name": f"{self.name}-{entry.label}-{task}-{tier}-{index}",
-            "seed": self.scenario_seed(task, index),
-            "sim": {"duration": self.duration(task)},
-            "reference": dict(tk.reference),
-            "initial": {"eta": eta, "nu": nu},
-            "controller": dict(entry.table),
-        }
-        values = self.tier_values(task, tier, index)
-        overrides = {**self.file.base, **tr.set, **values}
-        drawn = {f"start.{a}": (2.0 * unit[a] - 1.0) * getattr(tr.start, a) + 0.0 for a in START_AXES} | values
-        return raw, overrides, drawn
+        raw, overrides, drawn = conditions or self.conditions(task, tier, index)
+        raw = {"name": f"{self.name}-{entry.label}-{task}-{tier}-{index}", **raw, "controller": dict(entry.table)}
+        return raw, dict(overrides), dict(drawn)
 
     def fingerprint(self) -> str:
         """SHA-256 of everything that defines the runs (the file's contents and the variant)."""
