@@ -237,3 +237,9 @@ def test_ctrl_c_keeps_the_finished_chunks_and_resume_finishes(tiny, tmp_path):
     assert res.complete and res.execution.chunks_skipped == len(kept)
     runs = pd.read_parquet(out / "runs.parquet")
     assert sorted(runs["run"]) == list(range(len(resolve_controllers()) * 2 * 2 * 60))
+
+
+def test_the_sizing_numbers_of_the_docs_are_the_suite_s():
+    h = load_suite().failure_halfwidths()
+    text = (Path(__file__).resolve().parents[1] / "docs" / "benchmark.md").read_text()
+    assert f"{h['tier']:.4f}" in text and f"{h['zero_failures']:.3f}" in text and f"±{h['cell']:.3f}" in text
