@@ -1,9 +1,14 @@
 """Command line: ``auvtrack reproduce | run | check | bounds | study | sweep | compare | bench | warmup``.
 
-Bad input (a scenario error, a missing file, an invalid gain) prints ONE line to stderr and
-exits with status 2, never a traceback.  A simulation that fails (divergence, pitch limit,
-envelope violation) keeps and saves its partial result, prints the diagnostic and exits 3.
-Ctrl-C exits 130.  ``auvtrack --help`` lists every command and these exit codes.
+Bad input (a scenario error, a missing file, an invalid gain, a run over the plan's limits, an
+output folder that cannot be written) prints ONE line to stderr and exits with status 2, never a
+traceback, and before anything runs.  ``check`` runs exactly the validation of ``run`` (load,
+plan, controller set-up), so it refuses the same scenarios with the same message.  A simulation
+that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
+prints the diagnostic and exits 3.  Ctrl-C stops a run within about a second, saves what was
+computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps its
+completed chunks for ``--resume`` and exits 130 (so does ``compare``).  ``auvtrack --help`` lists every command and
+these exit codes.
 """
 from __future__ import annotations
 
@@ -17,6 +22,10 @@ import click
 
 EXIT_BAD_INPUT = 2
 EXIT_SIM_FAILED = 3
+EXIT_INTERRUPTED = 130
+MAX_WORKERS = 256
+MAX_REPEAT = 1000
+LONG_RUN_STEPS = 1_000_000  # runs this long announce themselves (and that Ctrl-C keeps their result)
 
 
 class BadInput(click.ClickException):
@@ -34,15 +43,31 @@ def _load(scenario: str, overrides: tuple[str, ...]):
     return load_scenario(scenario, list(overrides))
 
 
+def _prepare(scenario: str, sc):
+    """The run's validation after loading: plan and controller set-up (``check`` = ``run`` minus the run)."""
+    from .simulation.api import prepare
+
+    try:
+        return prepare(sc)
+    except ValueError as exc:  # ScenarioError of the plan, or a controller refusing its set-up
+        raise BadInput(f"{scenario}: {_one_line(exc)}") from None
+
+
+def _mib(n: int) -> str:
+    return f"{n / 2 ** 20:.3g} MiB"
+
+
 def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split()) or type(exc).__name__
 
 
 EXIT_CODES = (("0", "success"),
-              ("2", "bad input: one line naming the field and the allowed range, no traceback"),
+              ("2", "bad input: one line naming the field and the allowed range, no traceback, nothing run"),
               ("3", "a simulation failed (diverged, pitch limit, envelope violated): the diagnostic is printed "
                     "and the partial result kept"),
-              ("130", "interrupted (Ctrl-C)"))
+              ("130", "interrupted (Ctrl-C): a run keeps its partial result, a sweep or a comparison its "
+                      "completed chunks"))
+EXIT_CODES_HELP = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + "."
 COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "study", "sweep", "compare", "bench", "warmup")
 
 
@@ -85,29 +110,50 @@ set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALU
                           help="Override a scenario key, e.g. --set sim.dt=0.002 (repeatable).")
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("scenario")
-@click.option("--out", type=click.Path(file_okay=False), default=None,
-              help="Run folder, overwritten if it exists (default: a new runs/<name>-<controller>, "
-                   "numbered -2, -3, ... when taken).")
+@click.option("--out", default=None, metavar="FOLDER",
+              help="Run folder, replaced as a whole if it exists and holds only a run (default: a new "
+                   "runs/<name>-<controller>, numbered -2, -3, ... when taken).")
 @set_option
 @click.option("--mat", is_flag=True, help="Also write trajectory.mat (MATLAB).")
 def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -> None:
-    """Simulate SCENARIO (a TOML file) and write trajectory.csv and run.json to a run folder.
+    """Simulate SCENARIO (a TOML file) and write trajectory.csv, run.json and scenario.toml to a run folder.
 
     Without --out every run gets a new folder runs/<name>-<controller> (then -2, -3, ...), so a
-    second run never overwrites the first; the folder is printed.
+    second run never overwrites the first; the folder is printed.  The folder is checked before
+    the simulation starts, and scenario.toml reproduces the run (auvtrack run <folder>/scenario.toml).
     """
-    from .simulation.api import prepare, run_prepared
+    from .simulation.api import SimulationInterrupted, ensure_compiled, run_prepared
+    from .simulation.result import FolderError, prepare_run_folder
     from .simulation.run_folder import default_run_folder
 
     sc = _load(scenario, overrides)
-    prep = prepare(sc)
+    prep = _prepare(scenario, sc)
+    target = Path(out) if out is not None else default_run_folder(sc.name, sc.controller.kind)
+    try:  # before the run: an unwritable folder must not cost the simulation
+        prepare_run_folder(target)
+    except FolderError as exc:
+        raise BadInput(f"{'--out' if out is not None else 'run folder'}: {_one_line(exc)}") from None
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
-    res = run_prepared(prep)
-    folder = res.save(Path(out) if out else default_run_folder(sc.name, sc.controller.kind), mat=mat or sc.output.mat)
+    ensure_compiled([prep])  # compile or load the kernel first: Ctrl-C from here on stops the simulation
+    if prep.n_steps >= LONG_RUN_STEPS:
+        click.echo(f"running {prep.n_steps} RK4 steps (Ctrl-C stops the run and keeps its partial result)", err=True)
+    try:
+        res = run_prepared(prep)
+    except SimulationInterrupted as exc:  # stopped within about a second; write what was computed
+        res = exc.result
+    try:
+        folder = res.save(target, mat=mat or sc.output.mat, overwrite=out is not None)
+    except OSError as exc:  # FolderError (the folder changed since the check), a full disk...
+        click.echo(f"auvtrack: error: the run folder {target} could not be written: {_one_line(exc)}", err=True)
+        raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
+    if res.status == "interrupted":
+        click.echo(f"auvtrack: interrupted at t = {res.failure['time']:.6g} s after {res.meta['steps']} of "
+                   f"{prep.n_steps} steps; partial result kept in {folder}", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED)
     if not res.ok:
         f = res.failure
         click.echo(f"auvtrack: simulation failed at t = {f['time']:.6g} s: {f['cause']}: {f['detail']}; "
@@ -115,19 +161,29 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         raise click.exceptions.Exit(EXIT_SIM_FAILED)
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("scenario")
 @set_option
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
-    """Validate SCENARIO and its --set overrides without simulating (warns where Theorem 1's conditions fail)."""
+    """Validate SCENARIO and its --set overrides as run would (load, plan, controller set-up), without simulating.
+
+    Warns where Theorem 1's conditions fail.
+    """
+    from .scenario.plan import plan_run
+
     sc = _load(scenario, overrides)
+    prep = _prepare(scenario, sc)
+    for note in prep.notes:
+        click.echo(f"warning: {note}", err=True)
     if sc.controller.kind == "fxtntsmc":
         from .control.theory import check_theorem1
 
         for v in check_theorem1(sc.controller):
             click.echo(f"warning: {v}", err=True)
+    plan = plan_run(sc, len(prep.channels))
     click.echo(f"ok: {scenario} ({sc.name}: controller {sc.controller.kind}, "
-               f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s)")
+               f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s: {plan.n_steps} steps, {plan.log_rows} logged rows, "
+               f"~{_mib(plan.memory_bytes)})")
 
 
 @cli.command()
@@ -166,6 +222,11 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
     """
     from .runner.bench import bench_single
 
+    if not 1 <= repeat <= MAX_REPEAT:
+        raise BadInput(f"--repeat: must be in [1, {MAX_REPEAT}] (a median needs at least one timing) (got {repeat})")
+    if not duration > 0:
+        raise BadInput(f"--duration: must be > 0 s (got {duration:g})")
+
     if run_all:
         from .runner.bench import bench_all
 
@@ -192,39 +253,51 @@ def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
     click.echo(json.dumps(_warmup(controllers, plants, progress=True)))
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.argument("study")
-@click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default sweeps/<name>).")
+@click.option("--out", default=None, metavar="FOLDER", help="Output folder (default sweeps/<name>).")
 @click.option("--workers", type=int, default=None, help="Worker processes of the local Dask cluster (default: cores).")
+@click.option("--worker-memory", default="1GiB", show_default=True, metavar="SIZE",
+              help="Memory limit of each local worker (e.g. 2GiB); a sample that would not fit is recorded as failed.")
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Use an existing Dask scheduler, tcp://host:port.")
 @click.option("--resume", is_flag=True, help="Finish an interrupted sweep in --out (completed chunks are kept).")
 @click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def sweep(study: str, out: str | None, workers: int | None, scheduler: str | None, resume: bool,
+def sweep(study: str, out: str | None, workers: int | None, worker_memory: str, scheduler: str | None, resume: bool,
           max_chunks: int | None, quiet: bool) -> None:
     """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask: Parquet rows, quantiles, --resume.
 
     The study format is docs/sweeps.md; scenarios/sweep_example.toml is an example.
     """
-    from .runner.sweep import run_sweep
+    from .runner.sweep import parse_memory, run_sweep
     from .runner.sweep_schema import load_study
 
     if workers is not None and scheduler:
         raise BadInput("--workers and --scheduler exclude each other (the scheduler's cluster has its workers)")
-    if workers is not None and workers < 1:
-        raise BadInput(f"--workers: must be >= 1 (got {workers})")
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise BadInput(f"--workers: must be in [1, {MAX_WORKERS}] (got {workers})")
+    parse_memory(worker_memory)
     spec = load_study(study)
     folder = Path(out) if out else Path("sweeps") / spec.study.name
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        raise BadInput(f"--out: {folder}: is {'a symbolic link' if folder.is_symlink() else 'a file'}, not a folder")
 
     def _stop(signum, frame):  # SIGTERM / SIGINT: stop cleanly (cluster closed, chunks kept for --resume)
         raise KeyboardInterrupt
 
     import signal
 
-    handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)}
+    import threading
+
+    main_thread = threading.current_thread() is threading.main_thread()  # signals are the main thread's
+    handlers = {sig: signal.signal(sig, _stop) for sig in (signal.SIGTERM, signal.SIGINT)} if main_thread else {}
     try:
         res = run_sweep(spec, folder, workers=workers, scheduler=scheduler, resume=resume, max_chunks=max_chunks,
-                        progress=not quiet)
+                        progress=not quiet, memory_limit=worker_memory)
+    except KeyboardInterrupt:
+        click.echo(f"auvtrack: sweep interrupted (the cluster is closed, completed chunks are kept); finish with: "
+                   f"auvtrack sweep {study} --out {folder} --resume", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
     finally:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
@@ -239,7 +312,7 @@ def _split_names(values: tuple[str, ...]) -> list[str]:
     return [n.strip() for v in values for n in v.split(",") if n.strip()]
 
 
-@cli.command()
+@cli.command(epilog=EXIT_CODES_HELP)
 @click.option("--suite", "suite_name", default="auv-track-v1", show_default=True, metavar="NAME",
               help="A shipped suite (auvtrack/data/benchmarks/NAME.toml) or a suite TOML file.")
 @click.option("--controllers", "controllers", multiple=True, metavar="KIND[,KIND...]",
@@ -364,12 +437,16 @@ def main(argv: list[str] | None = None) -> int:
         rv = cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
     except click.exceptions.Exit as e:
         return e.exit_code
+    except click.UsageError as e:  # one line too, with where to look
+        where = f" (see '{e.ctx.command_path} --help')" if e.ctx is not None else ""
+        click.echo(f"auvtrack: error: {_one_line(e.format_message())}{where}", err=True)
+        return EXIT_BAD_INPUT
     except click.ClickException as e:
         e.show()
         return e.exit_code
-    except click.exceptions.Abort:
-        click.echo("auvtrack: aborted", err=True)
-        return 130
+    except click.exceptions.Abort:  # Ctrl-C outside a simulation (loading, compiling, saving)
+        click.echo("auvtrack: interrupted", err=True)
+        return EXIT_INTERRUPTED
     except (ScenarioError, ValueError, KeyError, OSError) as e:
         click.echo(f"auvtrack: error: {_one_line(e)}", err=True)
         return EXIT_BAD_INPUT

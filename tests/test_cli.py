@@ -55,6 +55,13 @@ def test_failed_run_exits_3_keeps_the_partial_result_and_says_why(tmp_path, caps
     (["run", str(PAPER), "--set", "vehicle.l=0"], "vehicle.l"),
     (["check", str(PAPER), "--set", "sim.dt=0"], "sim.dt"),
     (["bounds", str(PAPER), "--set", "controller.kind=ftsmc"], "controller.kind"),
+    (["bench", "--repeat", "0"], "--repeat: must be in [1, 1000]"),
+    (["bench", "--duration", "-1"], "--duration: must be > 0"),
+    (["run", str(PAPER), "--bogus"], "No such option '--bogus'"),  # usage errors are one line too
+    (["reproduce", "--out", str(PAPER)], "is a file"),
+    (["check", str(PAPER), "--set", "sim.duration=1e7"], "sim.duration: sim.duration / sim.dt"),
+    (["check", str(PAPER), "--set", "reference.kind=waypoints", "--set", 'reference.points=[[0,0,0],[1,"2",0]]'],
+     "reference.points.1.1: must be a number (got '2')"),
 ])
 def test_bad_input_is_one_line_with_status_2(args, field, capsys):
     assert main(args) == EXIT_BAD_INPUT
@@ -105,3 +112,15 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
         ctrl = json.loads((tmp_path / "tuned" / kind / "run.json").read_text())["scenario"]["controller"]
         for k, v in get_gain_preset(f"{kind}_tuned").gains.items():
             assert ctrl[k] == v, (kind, k)
+
+
+def test_subcommand_help_lists_the_exit_codes(capsys):
+    """The top-level --help has its own table (tests/test_cli_help.py); run, check and sweep repeat it."""
+    from auvtrack.cli import EXIT_CODES
+
+    for args in (["run", "--help"], ["check", "--help"], ["sweep", "--help"]):
+        assert main(args) == 0
+        text = " ".join(capsys.readouterr().out.split())
+        for code, meaning in EXIT_CODES:
+            assert f"{code} {' '.join(meaning.split())}" in text, (args, code)
+        assert "130 interrupted (Ctrl-C): a run keeps its partial result" in text

@@ -1,8 +1,10 @@
 """Result: access, pandas, run-folder round trip (CSV, JSON, MAT) and plots, on synthetic data."""
 from __future__ import annotations
 
+import hashlib
 import json
 import math
+import tomllib
 
 import numpy as np
 import pytest
@@ -134,7 +136,8 @@ def test_save_load_round_trip(tmp_path):
     res = make_result()
     folder = res.save(tmp_path / "a" / "run")
     assert folder == tmp_path / "a" / "run"
-    assert sorted(p.name for p in folder.iterdir()) == ["run.json", "trajectory.csv"]
+    assert sorted(p.name for p in folder.iterdir()) == ["run.json", "scenario.toml", "trajectory.csv"]
+    assert tomllib.loads((folder / "scenario.toml").read_text()) == res.scenario  # inf written as TOML inf
     back = Result.load(folder)
     assert back.names == res.names
     for name in res.names:
@@ -175,6 +178,18 @@ def test_csv_header_and_bytes(tmp_path):
     np.testing.assert_array_equal(df["ey"].to_numpy(), res["ey"])
 
 
+def test_csv_is_streamed_in_blocks_with_the_same_bytes(tmp_path):
+    """The block-wise writer gives exactly the text of the one-shot formula, across block edges."""
+    from auvtrack.simulation.result import CSV_BLOCK_ROWS
+
+    res = make_result(n=2 * CSV_BLOCK_ROWS + 17, extras=False)
+    cols = [list(map(repr, v.tolist())) for v in res.channels.values()]
+    expected = ",".join(res.names) + "\n" + "".join(",".join(r) + "\n" for r in zip(*cols))
+    assert (res.save(tmp_path / "big") / "trajectory.csv").read_text() == expected
+    assert Result(res.channels, {}, "ok", None, {}).save(tmp_path / "empty-scenario").joinpath(
+        "scenario.toml").exists() is False  # no scenario, no scenario.toml
+
+
 def test_json_is_strict_and_converted(tmp_path):
     res = make_result(status="failed")
     res.save(tmp_path)
@@ -184,7 +199,10 @@ def test_json_is_strict_and_converted(tmp_path):
         raise AssertionError(f"non-standard JSON constant {name}")
 
     doc = json.loads(raw, parse_constant=no_constants)
-    assert list(doc) == ["version", "status", "failure", "metrics", "scenario", "meta", "nonfinite"]
+    assert list(doc) == ["version", "status", "failure", "metrics", "scenario", "meta", "nonfinite", "files"]
+    for name in ("trajectory.csv", "scenario.toml"):
+        data = (tmp_path / name).read_bytes()
+        assert doc["files"][name] == {"sha256": hashlib.sha256(data).hexdigest(), "bytes": len(data)}
     assert doc["version"] == auvtrack.__version__
     assert doc["metrics"]["settle_1mm_x"] is None  # inf -> null
     assert doc["nonfinite"]["/metrics/settle_1mm_x"] == "inf"

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pytest
+from distributed.diagnostics.plugin import WorkerPlugin
 
 from auvtrack.cli import main
 from auvtrack.scenario import load_scenario
@@ -188,9 +189,17 @@ BAD = [
     ("samples = 60", "samples = 0", "samples: must be >= 1 (got 0)"),
     ("high = 0.4", "high = -1.0", "random.uncertainty.D"),
     ('"uncertainty.C" = [0.0, 0.2]', '"uncertainty.C" = [0.0, 5.0]', "grid.uncertainty.C.1: the scenario rejects it"),
-    ('dist = "normal"', 'dist = "cauchy"', "random.uncertainty.M"),
+    ('dist = "normal"', 'dist = "cauchy"', "random.uncertainty.M.dist: unknown dist (allowed: 'uniform', 'normal'"),
     ('scenario = "paper"', 'scenario = "paper"\nworkers = 3', "workers: unknown key"),
-    ('"uncertainty.C" = [0.0, 0.2]', '"uncertainty.C" = []', "grid.uncertainty.C"),
+    ('"uncertainty.C" = [0.0, 0.2]', '"uncertainty.C" = []', "grid.uncertainty.C: must have at least 1 item (got 0)"),
+    # a value `auvtrack run` would refuse (the run plan's limits, the controller's set-up) refuses the study
+    ('"uncertainty.C" = [0.0, 0.2]', '"uncertainty.C" = [0.0, 0.2]\n"sim.duration" = [1e9]',
+     "grid.sim.duration.0: the scenario rejects it: sim.duration: "),
+    # the name becomes the folder sweeps/<name>: the rule of scenario names
+    ('name = "t"', 'name = "../../x"', "name: must be 1 to 100 characters"),
+    ('name = "t"', 'name = "/tmp/abs"', "name: must be 1 to 100 characters"),
+    ('name = "t"', 'name = ".."', "name: must be 1 to 100 characters"),
+    ('name = "t"', 'name = "a\\u0000b"', "name: must be 1 to 100 characters"),
     ('scenario = "paper"', 'scenario = "missing.toml"', "scenario: must be 'paper' or a readable"),
     ('set = ["sim.duration=0.2", "estimator.neurons=3"]', 'set = ["sim.dt=-1"]', "sim.dt"),
     ('"controller.kind"', '"controller..kind"', "not a dotted scenario key"),
@@ -211,8 +220,82 @@ def test_invalid_study_file_one_line_exit_2(tmp_path, capsys, old, new, expect):
 
 def test_bad_cli_options_exit_2(tmp_path, capsys):
     study = write_study(tmp_path)
+    (tmp_path / "afile").write_text("x")
     assert main(["sweep", str(study), "--workers", "0"]) == 2
     assert main(["sweep", str(study), "--workers", "1", "--scheduler", "tcp://x:1"]) == 2
     assert main(["sweep", str(tmp_path / "nope.toml")]) == 2
+    assert main(["sweep", str(study), "--worker-memory", "lots"]) == 2
+    assert main(["sweep", str(study), "--worker-memory", "1MB"]) == 2
+    assert main(["sweep", str(study), "--out", str(tmp_path / "afile")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 3 and all(line.startswith("auvtrack: error: ") for line in err)
+    assert len(err) == 6 and all(line.startswith("auvtrack: error: ") for line in err), err
+    assert "--worker-memory" in err[3] and "--out" in err[5] and "is a file" in err[5]
+
+
+MEMORY_STUDY = """
+name = "mem-hog"
+scenario = "paper"
+set = ["sim.duration=0.2", "estimator.neurons=3", "disturbance.1.kind=current"]
+samples = 1
+chunk_size = 4
+
+[grid]                            # sample 1: 5e6 current samples (~640 MB of tables)
+"disturbance.1.sample_dt" = [0.01, 4e-8, 0.005, 0.02]
+"""
+HOG = 2  # the sample whose worker runs out of memory (see MemoryHog)
+
+
+class MemoryHog(WorkerPlugin):
+    """Worker plugin of the test: sample HOG of study "mem-hog" allocates more than the worker's
+    memory limit while it runs, as a sample whose real use exceeds its estimate would, so that
+    Dask's nanny kills the worker (also every restarted one: plugins run on each)."""
+
+    name = "test-memory-hog"
+
+    def setup(self, worker):
+        import time
+
+        import numpy as np
+
+        from auvtrack.runner import sweep_worker
+
+        limit = worker.memory_manager.memory_limit
+        original = sweep_worker.run_samples
+
+        def run_samples(spec, indices):
+            if spec.study.name == "mem-hog" and HOG in indices:
+                hog = np.ones(int(1.2 * limit) // 8)  # written, so resident
+                time.sleep(60)
+                del hog
+            return original(spec, indices)
+
+        sweep_worker.run_samples = run_samples
+
+
+def test_sweep_survives_samples_over_the_memory_limit(tmp_path):
+    """One sample refused up front by its memory estimate, one that kills its worker anyway:
+    both recorded as failed with their cause, every other sample computed, the sweep complete."""
+    from auvtrack.runner.sweep import _client
+
+    study = write_study(tmp_path, text=MEMORY_STUDY)
+    client, cluster = _client(1, None, "1GiB")  # the CLI's own cluster settings
+    try:
+        client.register_plugin(MemoryHog())
+        outcome = run_sweep(study, tmp_path / "out", client=client, progress=False)
+    finally:
+        client.close()
+        cluster.close()
+    assert outcome.complete
+    df = read_results(tmp_path / "out")
+    assert df["sample"].tolist() == [0, 1, 2, 3]
+    assert df["status"].tolist() == ["ok", "failed", "failed", "ok"]
+    assert df["cause"].tolist()[1:3] == ["memory", "worker_died"]
+    assert "MiB" in df["detail"][1] and "--worker-memory" in df["detail"][1]
+    assert "worker process died" in df["detail"][2]
+    assert outcome.summary["causes"] == {"memory": 1, "worker_died": 1}
+    # the computed rows are those of the samples run on their own
+    spec = load_study(study)
+    for i in (0, 3):
+        res = run_prepared(prepare(load_scenario(spec.base, spec.overrides(i)[1])))
+        np.testing.assert_array_equal(df.loc[i, list(METRIC_NAMES)].to_numpy(float),
+                                      np.array([res.metrics[m] for m in METRIC_NAMES]))

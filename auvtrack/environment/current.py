@@ -44,7 +44,7 @@ from ..plant.params import D0
 from . import _validate as val
 from .layout import C_DT, C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, ROW_SIZE
 
-MAX_SAMPLES = 20_000_000  # per current component (~640 MB of table); guards against a tiny sample_dt
+MAX_SAMPLES = 2 ** 31  # hard ceiling per current component; the run plan enforces limits.max_table_rows first
 
 
 @dataclass(frozen=True, kw_only=True)

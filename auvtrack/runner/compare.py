@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import time
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
+
+from .._atomic import atomic_file, atomic_write
 
 __all__ = ["RunSpec", "plan_runs", "run_chunk", "execute", "ExecOutcome", "CompareError", "chunk_path",
            "MANIFEST", "RUNS_FILE", "FIXED_COLUMNS"]
@@ -203,15 +204,8 @@ class ExecOutcome:
 def _write_atomic_table(table, path: Path) -> None:
     import pyarrow.parquet as pq
 
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:6]}")
-    pq.write_table(table, tmp)
-    os.replace(tmp, path)
-
-
-def _write_atomic_text(text: str, path: Path) -> None:
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:6]}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    with atomic_file(path) as fh:  # unique, exclusively created temporary name, then rename
+        pq.write_table(table, fh)
 
 
 def _prepare_out(out: Path, manifest: dict, n_chunks: int, resume: bool) -> set[int]:
@@ -234,8 +228,8 @@ def _prepare_out(out: Path, manifest: dict, n_chunks: int, resume: bool) -> set[
                                "pass --resume to finish it or choose another folder")
     elif done:
         raise CompareError(f"--out: {out} holds chunk files but no {MANIFEST}; choose another folder")
-    _write_atomic_text(json.dumps(manifest, indent=2), man)
-    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp-*"):
+    atomic_write(man, json.dumps(manifest, indent=2))
+    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp"):  # left by an interrupted write
         stale.unlink(missing_ok=True)
     return done
 

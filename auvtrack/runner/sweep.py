@@ -17,13 +17,13 @@ from __future__ import annotations
 import json
 import logging
 import math
-import os
 import time
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
+from .._atomic import atomic_file, atomic_write
 from .sweep_schema import StudyError, StudySpec, load_study
 
 MANIFEST = "study.json"
@@ -68,15 +68,12 @@ def chunk_path(out: Path, chunk: int) -> Path:
 def _write_atomic_table(table, path: Path) -> None:
     import pyarrow.parquet as pq
 
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    pq.write_table(table, tmp)
-    os.replace(tmp, path)
+    with atomic_file(path) as fh:  # unique, exclusively created temporary name, then rename
+        pq.write_table(table, fh)
 
 
 def _write_atomic_text(text: str, path: Path) -> None:
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    atomic_write(path, text)
 
 
 def _manifest(spec: StudySpec) -> dict:
@@ -109,13 +106,46 @@ def _prepare_out(spec: StudySpec, out: Path, resume: bool) -> set[int]:
     elif done:
         raise StudyError(f"--out: {out} holds chunk files but no {MANIFEST}; choose another folder")
     _write_atomic_text(json.dumps(_manifest(spec), indent=2), man_path)
-    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp-*"):  # left by an interrupted write
+    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp"):  # left by an interrupted write
         stale.unlink(missing_ok=True)
     return done
 
 
-def _client(workers: int | None, scheduler: str | None, memory_limit: str):
+DEFAULT_WORKER_MEMORY = "1GiB"
+
+
+def parse_memory(value: str | int) -> int:
+    """Bytes of a memory size such as ``"1GiB"``, ``"512MB"`` or an integer number of bytes.
+
+    Parameters
+    ----------
+    value : str or int
+        The size.
+
+    Returns
+    -------
+    int
+        Bytes, >= 64 MiB (a worker needs about 300 MB for Python, NumPy, Numba and the kernels).
+
+    Raises
+    ------
+    StudyError
+        One line naming ``--worker-memory`` for anything else.
+    """
+    from dask.utils import parse_bytes
+
+    try:
+        n = value if isinstance(value, int) and not isinstance(value, bool) else parse_bytes(str(value))
+    except (ValueError, TypeError):
+        raise StudyError(f"--worker-memory: must be a size such as 2GiB or 512MB (got {value!r})") from None
+    if n < 64 * 2 ** 20:
+        raise StudyError(f"--worker-memory: must be >= 64MiB (got {value!r})")
+    return int(n)
+
+
+def _client(workers: int | None, scheduler: str | None, memory_limit: str | int):
     """(client, cluster or None): a LocalCluster of ``workers`` processes or an existing scheduler."""
+    import dask
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
@@ -123,14 +153,18 @@ def _client(workers: int | None, scheduler: str | None, memory_limit: str):
     from .batch import default_workers
 
     n = default_workers() if workers is None else workers
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                           memory_limit=memory_limit, env={"NUMBA_NUM_THREADS": "1"}, silence_logs=logging.ERROR)
+    # a task whose worker dies is not retried on other workers (it would kill them too): its
+    # chunk is split into single samples instead (_compute)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               memory_limit=parse_memory(memory_limit), env={"NUMBA_NUM_THREADS": "1"},
+                               silence_logs=logging.ERROR)
     return Client(cluster), cluster
 
 
 def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False, max_chunks: int | None = None,
-              progress: bool = True, client: Any = None, memory_limit: str = "1GiB",
+              progress: bool = True, client: Any = None, memory_limit: str | int = DEFAULT_WORKER_MEMORY,
               on_chunk: Callable[[int, Any], None] | None = None) -> SweepOutcome:
     """Run (or resume) a sweep on Dask and write its results under ``out``.
 
@@ -152,8 +186,10 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
         Show a tqdm bar (samples done, rate, ETA).
     client : distributed.Client, optional
         Use this client (its cluster is left running); overrides ``workers``/``scheduler``.
-    memory_limit : str, optional
-        Per-worker memory limit of the LocalCluster.
+    memory_limit : str or int, optional
+        Per-worker memory limit of the LocalCluster (``"1GiB"``, ``"512MB"``, bytes).  A sample
+        whose tables would not fit is recorded as failed (cause ``memory``) without running; a
+        sample whose worker still dies is recorded as failed (cause ``worker_died``).
     on_chunk : callable, optional
         ``on_chunk(chunks_written_now, client)`` after each chunk file is written (a hook for
         tests and monitoring).
@@ -172,6 +208,7 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
         raise StudyError(f"--workers: must be >= 1 (got {workers})")
     if max_chunks is not None and max_chunks < 1:
         raise StudyError(f"max_chunks: must be >= 1 (got {max_chunks})")
+    parse_memory(memory_limit)
     out = Path(out)
     done = _prepare_out(spec, out, resume)
     todo = [c for c in range(spec.n_chunks) if c not in done]
@@ -219,7 +256,7 @@ def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: in
     try:
         for fut in as_completed(futures):
             c = chunk_of[fut.key]
-            table = fut.result()
+            table = _chunk_table(spec, c, fut, client, token)
             path = chunk_path(out, c)
             if not path.exists():  # idempotent: a chunk is written once
                 _write_atomic_table(table, path)
@@ -238,6 +275,40 @@ def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: in
     return written, time.perf_counter() - t0
 
 
+def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str, attempts: int = 2):
+    """The table of a finished chunk task; when its worker died, run its samples one at a time.
+
+    A worker that dies fails every task queued on it, so a sample is blamed only when it kills a
+    worker ``attempts`` times running on its own: it is then recorded as failed (cause
+    ``worker_died``), and one memory-hungry sample costs its own row, never the sweep.
+    """
+    from distributed import KilledWorker
+
+    from .sweep_worker import lost_rows, run_samples
+
+    try:
+        return fut.result()
+    except KilledWorker:
+        pass
+    import pyarrow as pa
+
+    tables = []
+    for i in spec.chunk_range(chunk):
+        for attempt in range(attempts):
+            single = client.submit(run_samples, spec, [i], key=f"auvtrack-sample-{token}-{i}-{attempt}", retries=0)
+            try:
+                tables.append(single.result())
+                break
+            except KilledWorker as exc:
+                reason = " ".join(str(exc).split())[:200]
+            finally:
+                single.release()
+        else:
+            tables.append(lost_rows(spec, [i], f"the worker process died running this sample alone, {attempts} times "
+                                               f"(out of memory? see --worker-memory): {reason}"))
+    return pa.concat_tables(tables)
+
+
 def combine(spec: StudySpec, out: Path) -> Path:
     """Stream every chunk file, in chunk order, into ``out/results.parquet`` (atomic)."""
     import pyarrow.parquet as pq
@@ -246,11 +317,9 @@ def combine(spec: StudySpec, out: Path) -> Path:
 
     schema = result_schema(spec)
     path = out / RESULTS
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    with pq.ParquetWriter(tmp, schema) as writer:
+    with atomic_file(path) as fh, pq.ParquetWriter(fh, schema) as writer:
         for c in range(spec.n_chunks):
             writer.write_table(pq.read_table(chunk_path(out, c), schema=schema))
-    os.replace(tmp, path)
     return path
 
 

@@ -20,9 +20,11 @@ from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
+from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator,
+                      model_validator)
 
 from ..scenario.errors import ScenarioError, format_value, one_line, translate
+from ..scenario.names import check_name
 
 __all__ = ["StudyError", "StudyFile", "StudySpec", "load_study", "PAPER_SCENARIO", "MAX_SAMPLES"]
 
@@ -118,6 +120,11 @@ class StudyFile(_Model):
     common_seeds: Annotated[bool, Strict()] = False
     grid: dict[str, Annotated[list[Any], Field(min_length=1)]] = Field(default_factory=dict)
     random: dict[str, Distribution] = Field(default_factory=dict)
+
+    @field_validator("name")
+    @classmethod
+    def _name(cls, v: str) -> str:
+        return check_name(v)  # it becomes the folder sweeps/<name>: the rule of scenario names
 
     @model_validator(mode="after")
     def _keys(self) -> "StudyFile":
@@ -258,17 +265,43 @@ def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
         raise _fail(source, "set", str(exc)) from None
 
 
-def _probe(spec: StudySpec, field: str, overrides: dict) -> None:
+def _problem(spec: StudySpec, overrides: dict) -> ValueError | None:
+    """Validate one sample as ``auvtrack check`` would (load, plan, controller set-up); the error or None."""
+    import warnings
+
     from ..scenario import load_scenario
+    from ..simulation.api import prepare
 
     try:
-        load_scenario(spec.base, overrides)
-    except ScenarioError as exc:
-        raise _fail(spec.source, field, f"the scenario rejects it: {exc}") from None
+        sc = load_scenario(spec.base, overrides)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            prepare(sc)
+    except ValueError as exc:  # ScenarioError of the schema or the run plan, a controller refusing its set-up
+        return exc
+    return None
+
+
+def _error_path(exc: ValueError) -> str:
+    """Dotted scenario path an error names (``ScenarioError.path``, else its leading ``a.b: ``)."""
+    path = getattr(exc, "path", "")
+    if path:
+        return path
+    m = re.match(r"^(?:<[^>]*>: )?([A-Za-z_][\w]*(?:\.\w+)*): ", str(exc))
+    return m.group(1) if m else ""
+
+
+def _probe(spec: StudySpec, field: str, overrides: dict) -> None:
+    exc = _problem(spec, overrides)
+    if exc is not None:
+        raise _fail(spec.source, field, f"the scenario rejects it: {one_line(str(exc))}") from None
 
 
 def check_against_scenario(spec: StudySpec) -> None:
-    """Validate the base scenario, every grid value and each random range against the scenario schema.
+    """Validate the base scenario, every grid value and each random range as ``auvtrack check`` would.
+
+    Each probe is loaded, planned (``[limits]``) and set up by its controller, so a grid value
+    that ``auvtrack run`` would refuse (``sim.duration = 1e9``) refuses the study up front.
 
     Raises
     ------
@@ -278,6 +311,12 @@ def check_against_scenario(spec: StudySpec) -> None:
     study = spec.study
     _probe(spec, "set" if study.set else "scenario", {})
     first = {k: v[0] for k, v in study.grid.items()}
+    exc = _problem(spec, first)
+    if exc is not None:  # the first grid point: blame the grid key the error names
+        path = _error_path(exc)
+        named = [k for k in study.grid if path == k or path.startswith(k + ".") or k.startswith(path + ".")]
+        key = named[0] if named else next(iter(study.grid))
+        raise _fail(spec.source, f"grid.{key}.0", f"the scenario rejects it: {one_line(str(exc))}")
     for key, vals in study.grid.items():
         for j, v in enumerate(vals):
             _probe(spec, f"grid.{key}.{j}", {**first, key: v})

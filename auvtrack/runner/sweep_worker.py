@@ -16,8 +16,8 @@ STATUS_OK, STATUS_FAILED, STATUS_INVALID = "ok", "failed", "invalid"
 FIXED_COLUMNS = ("sample", "point", "replicate")
 TAIL_COLUMNS = ("seed", "status", "cause", "detail", "fail_time")
 
-__all__ = ["run_chunk", "result_schema", "WarmupPlugin", "worker_warmup", "STATUS_OK", "STATUS_FAILED",
-           "STATUS_INVALID"]
+__all__ = ["run_chunk", "run_samples", "lost_rows", "result_schema", "worker_memory_budget", "WarmupPlugin",
+           "worker_warmup", "STATUS_OK", "STATUS_FAILED", "STATUS_INVALID", "CAUSE_MEMORY", "CAUSE_WORKER_DIED"]
 
 
 def _grid_type(values: list[Any]):
@@ -54,20 +54,114 @@ def result_schema(spec: StudySpec):
     return pa.schema(fields)
 
 
-def _prepare_sample(spec: StudySpec, index: int):
-    """(seed, Prepared or error text) of one sample."""
+MEMORY_FRACTION = 0.8  # of the worker's limit: Dask pauses a worker there and kills it at 95 %
+CAUSE_MEMORY, CAUSE_WORKER_DIED = "memory", "worker_died"
+
+
+def worker_memory_budget() -> int | None:
+    """Bytes a sample may still allocate in this Dask worker, or None outside a worker / without a limit.
+
+    The budget is :data:`MEMORY_FRACTION` of the worker's memory limit minus what the process
+    already uses (its resident set: interpreter, libraries, compiled kernels).
+    """
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return None
+    manager = getattr(worker, "memory_manager", None)
+    limit = getattr(manager, "memory_limit", None) or getattr(worker, "memory_limit", None)
+    if not limit:
+        return None
+    import psutil
+
+    return int(MEMORY_FRACTION * limit) - psutil.Process().memory_info().rss
+
+
+def _prepare_sample(spec: StudySpec, index: int, budget: int | None):
+    """(seed, Prepared, or (status, cause, detail) of a sample that does not run)."""
     import warnings
 
     from ..scenario import ScenarioError, load_scenario
+    from ..scenario.plan import plan_run
     from ..simulation.api import prepare
 
     seed, ov = spec.overrides(index)
     try:
+        sc = load_scenario(spec.base, ov)
+        if budget is not None:  # metrics only: no log, the noise and current tables are what grows
+            need = plan_run(sc, 0).table_bytes
+            if need > budget:
+                return seed, (STATUS_FAILED, CAUSE_MEMORY,
+                              f"its noise and current tables need an estimated {need / 2 ** 20:.0f} MiB, more than "
+                              f"the {budget / 2 ** 20:.0f} MiB this worker has left "
+                              f"({MEMORY_FRACTION:.0%} of its memory limit; raise it with --worker-memory)")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return seed, prepare(load_scenario(spec.base, ov))
+            return seed, prepare(sc)
     except (ScenarioError, ValueError) as exc:
-        return seed, " ".join(str(exc).split()) or type(exc).__name__
+        return seed, (STATUS_INVALID, "invalid", " ".join(str(exc).split()) or type(exc).__name__)
+
+
+def _base_row(spec: StudySpec, i: int, seed: int) -> dict[str, Any]:
+    point, rep, _ = spec.sample(i)
+    return {"sample": i, "point": point, "replicate": rep, **spec.column_values(i), "seed": seed}
+
+
+def _table(spec: StudySpec, rows: list[dict[str, Any]]):
+    import pyarrow as pa
+
+    schema = result_schema(spec)
+    return pa.Table.from_pydict({f.name: [r[f.name] for r in rows] for f in schema}, schema=schema)
+
+
+def _not_run(row: dict[str, Any], status: str, cause: str, detail: str) -> dict[str, Any]:
+    from ..simulation.metrics import METRIC_NAMES
+
+    row.update(status=status, cause=cause, detail=detail, fail_time=math.nan)
+    row.update({m: math.nan for m in METRIC_NAMES})
+    return row
+
+
+def run_samples(spec: StudySpec, indices: list[int]):
+    """Run the samples ``indices`` (metrics only) and return their rows as an Arrow table.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The loaded study (plain data).
+    indices : list of int
+        Sample indices, in the order of the rows.
+
+    Returns
+    -------
+    pyarrow.Table
+        One row per sample, schema :func:`result_schema`.  A sample whose values the scenario
+        rejects has status ``"invalid"`` and the one-line reason in ``detail``; a sample whose
+        tables would not fit in this worker's memory (:func:`worker_memory_budget`) has status
+        ``"failed"`` and cause ``"memory"`` and is not run; a simulation failure has status
+        ``"failed"``, its cause and time.
+    """
+    from .batch import run_batch
+
+    budget = worker_memory_budget()
+    prepared = [_prepare_sample(spec, i, budget) for i in indices]
+    runnable = [p for _, p in prepared if not isinstance(p, tuple)]
+    summaries = iter(run_batch(runnable, backend="serial"))
+    rows = []
+    for i, (seed, prep) in zip(indices, prepared):
+        row = _base_row(spec, i, seed)
+        if isinstance(prep, tuple):
+            rows.append(_not_run(row, *prep))
+            continue
+        s = next(summaries)
+        f = s.failure or {}
+        row.update(status=s.status, cause=f.get("cause", ""), detail=f.get("detail", ""),
+                   fail_time=f.get("time", math.nan))
+        row.update(s.metrics)
+        rows.append(row)
+    return _table(spec, rows)
 
 
 def run_chunk(spec: StudySpec, chunk: int):
@@ -83,36 +177,30 @@ def run_chunk(spec: StudySpec, chunk: int):
     Returns
     -------
     pyarrow.Table
-        One row per sample, schema :func:`result_schema`, in sample order.  A sample whose
-        values the scenario rejects has status ``"invalid"`` and the one-line reason in
-        ``detail``; a simulation failure has status ``"failed"``, its cause and time.
+        One row per sample, schema :func:`result_schema`, in sample order (see :func:`run_samples`).
     """
-    import pyarrow as pa
+    return run_samples(spec, list(spec.chunk_range(chunk)))
 
-    from .batch import run_batch
-    from ..simulation.metrics import METRIC_NAMES
 
-    schema = result_schema(spec)
-    indices = list(spec.chunk_range(chunk))
-    prepared = [_prepare_sample(spec, i) for i in indices]
-    runnable = [p for _, p in prepared if not isinstance(p, str)]
-    summaries = iter(run_batch(runnable, backend="serial"))
-    cols: dict[str, list] = {f.name: [] for f in schema}
-    for i, (seed, prep) in zip(indices, prepared):
-        point, rep, _ = spec.sample(i)
-        row: dict[str, Any] = {"sample": i, "point": point, "replicate": rep, **spec.column_values(i), "seed": seed}
-        if isinstance(prep, str):
-            row.update(status=STATUS_INVALID, cause="invalid", detail=prep, fail_time=math.nan)
-            row.update({m: math.nan for m in METRIC_NAMES})
-        else:
-            s = next(summaries)
-            f = s.failure or {}
-            row.update(status=s.status, cause=f.get("cause", ""), detail=f.get("detail", ""),
-                       fail_time=f.get("time", math.nan))
-            row.update(s.metrics)
-        for name in cols:
-            cols[name].append(row[name])
-    return pa.Table.from_pydict(cols, schema=schema)
+def lost_rows(spec: StudySpec, indices: list[int], detail: str):
+    """Rows recording samples that could not be computed because their worker process died.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The loaded study.
+    indices : list of int
+        The samples.
+    detail : str
+        Why (one line), stored in ``detail``.
+
+    Returns
+    -------
+    pyarrow.Table
+        Status ``"failed"``, cause ``"worker_died"``, metrics NaN.
+    """
+    return _table(spec, [_not_run(_base_row(spec, i, spec.sample_seed(i)), STATUS_FAILED, CAUSE_WORKER_DIED, detail)
+                         for i in indices])
 
 
 def worker_warmup() -> dict:

@@ -89,7 +89,26 @@ def _describe(obj: Any, spec: dict) -> dict:
     return jsonable({"kind": spec["kind"], **{k: v for k, v in out.items() if k != "kind"}})
 
 
+def _strict_arrays(spec: Mapping[str, Any]) -> None:
+    """Arrays of a component hold finite numbers (or arrays of them): a string or boolean is
+    refused here, naming its index, before NumPy would silently read ``"2"`` as 2.0."""
+    def walk(path: str, value: Any) -> None:
+        for i, x in enumerate(value):
+            where = f"{path}.{i}"
+            if isinstance(x, (list, tuple)):
+                walk(where, x)
+            elif isinstance(x, bool) or not isinstance(x, (int, float)):
+                raise ValueError(f"{where}: must be a number (got {format_value(x)})")
+            elif not math.isfinite(x):
+                raise ValueError(f"{where}: must be a finite number (got {format_value(x)})")
+
+    for key, value in spec.items():
+        if isinstance(value, (list, tuple)):
+            walk(str(key), value)
+
+
 def _build(builder: Callable[[dict], Any], spec: dict) -> dict:
+    _strict_arrays(spec)
     try:
         obj = builder(dict(spec))
     except (ValueError, TypeError, KeyError) as exc:
@@ -162,5 +181,5 @@ def check_disturbances(value: Any) -> list[dict]:
         try:
             out.append(_build(build, spec))
         except ValueError as exc:
-            raise ValueError(f"{i}.{exc}" if re.match(r"^[A-Za-z_]\w*: ", str(exc)) else f"{i}: {exc}") from None
+            raise ValueError(f"{i}.{exc}" if re.match(r"^[A-Za-z_][\w.]*: ", str(exc)) else f"{i}: {exc}") from None
     return out

@@ -164,15 +164,16 @@ def _describe(err: dict, root: type[BaseModel]) -> tuple[str, str]:
             path = path + m.group(1).split(".")
             text = m.group(2)
         return ".".join(path), text
-    if etype == "union_tag_invalid":
+    if etype in ("union_tag_invalid", "union_tag_not_found"):
+        tag = str(ctx.get("discriminator", "kind")).strip("'\"") or "kind"  # "kind", or "dist" of a sweep
+        if etype == "union_tag_not_found":
+            return ".".join(path + [tag]), "required key is missing"
         tags = ctx.get("expected_tags", "")
-        return ".".join(path + ["kind"]), f"unknown kind (allowed: {tags}) (got {format_value(ctx.get('tag'))})"
-    if etype == "union_tag_not_found":
-        return ".".join(path + ["kind"]), "required key is missing"
+        return ".".join(path + [tag]), f"unknown {tag} (allowed: {tags}) (got {format_value(ctx.get('tag'))})"
     bounds = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<", "less_than_equal": "<="}
     if etype in bounds:
         limit = next(v for k, v in ctx.items() if k in ("gt", "ge", "lt", "le"))
-        shown = f"{limit:g}" if isinstance(limit, (int, float)) else str(limit)
+        shown = str(limit) if isinstance(limit, int) else f"{limit:g}" if isinstance(limit, float) else str(limit)
         return ".".join(path), f"must be {bounds[etype]} {shown}" + got
     simple = {
         "finite_number": "must be a finite number",
@@ -192,7 +193,12 @@ def _describe(err: dict, root: type[BaseModel]) -> tuple[str, str]:
     if etype in ("too_short", "too_long"):
         n = ctx.get("min_length") if etype == "too_short" else ctx.get("max_length")
         actual = ctx.get("actual_length")
-        return ".".join(path), f"must have {n} items (got {actual})"
+        _, ann = _walk(root, err["loc"])
+        items = f"{n} item{'' if n == 1 else 's'}"
+        if _fixed_length(ann) is not None:  # a fixed-length array: the exact count
+            return ".".join(path), f"must have {items} (got {actual})"
+        bound = "at least" if etype == "too_short" else "at most"
+        return ".".join(path), f"must have {bound} {items} (got {actual})"
     return ".".join(path), one_line(err.get("msg", etype)) + got
 
 

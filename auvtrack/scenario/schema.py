@@ -16,14 +16,16 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_v
 
 from ..control import CONTROLLERS
 from ..control.params import FXTNTSMCParams, available_gain_presets, get_gain_preset
+from ..environment.current import MAX_SAMPLES as MAX_CURRENT_SAMPLES
 from ..plant.presets import available, get_preset
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
+from .names import check_name
 
 __all__ = [
     "CONTROLLER_MODELS", "ControllerParams", "Scenario", "SimSection", "VehicleSection",
     "UncertaintySection", "InitialSection", "EnvelopeSection", "EstimatorSection",
-    "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection",
+    "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection", "LimitsSection",
 ]
 
 # --- strict scalar types ------------------------------------------------------------------------
@@ -40,6 +42,11 @@ Pos5 = tuple[Pos, Pos, Pos, Pos, Pos]
 NonNeg5 = tuple[NonNeg, NonNeg, NonNeg, NonNeg, NonNeg]
 Range2 = tuple[Num, Num]
 Fraction = Annotated[Num, Field(ge=-0.9, le=2.0)]
+# physically meaningful vehicle numbers (a 1 kg model to a 10 000 t submarine; docs/scenarios.md)
+Mass = Annotated[Num, Field(ge=1e-3, le=1e7)]
+Coefficient = Annotated[Num, Field(ge=0, le=1e7)]
+Mass5 = tuple[Mass, Mass, Mass, Mass, Mass]
+Coefficient5 = tuple[Coefficient, Coefficient, Coefficient, Coefficient, Coefficient]
 Open01 = Annotated[Num, Field(gt=0, lt=1)]
 
 # Controllers selectable by ``[controller] kind``: the parameter model of every registered controller.
@@ -49,12 +56,24 @@ DEFAULT_CONTROLLER = "fxtntsmc"
 _CONTROLLER_BY_KIND = {m.model_fields["kind"].default: m for m in CONTROLLER_MODELS}
 
 MULTIPLE_RTOL = 1e-9
+# Beyond 2**53 steps the step times k*dt are no longer exact; the run plan refuses such a grid
+# long before (limits.max_steps <= 2**53), so the grid rules below leave it to the plan's message.
+MAX_EXACT_STEPS = 2 ** 53
 
 
 def is_multiple(value: float, step: float) -> bool:
     """True when ``value`` is a positive integer multiple of ``step`` within 1e-9 relative."""
-    n = round(value / step)
+    q = value / step
+    if not math.isfinite(q):
+        return False
+    n = round(q)
     return n >= 1 and abs(n * step - value) <= MULTIPLE_RTOL * value
+
+
+def _steps_beyond_exact(value: float, step: float) -> bool:
+    """True when ``value / step`` is too large to be a step count (the plan refuses it)."""
+    q = value / step
+    return not math.isfinite(q) or q > MAX_EXACT_STEPS
 
 
 class _Section(BaseModel):
@@ -69,11 +88,17 @@ def _broadcast3(value: Any) -> Any:
 
 
 class SimSection(_Section):
-    """``[sim]``: time grid, control sampling and divergence guards."""
+    """``[sim]``: time grid, control sampling and divergence guards.
+
+    The grid rules: ``dt <= duration``; ``duration``, ``log_dt`` and ``1/control_rate`` are
+    integer multiples of ``dt``; ``log_dt`` divides ``duration`` (the log always ends with the
+    final state, t = duration); ``1/control_rate <= duration``.  Step counts are bounded by the
+    run plan (:mod:`auvtrack.scenario.plan`, ``[limits]``).
+    """
 
     duration: Pos = Field(100.0, description="simulated time, s")
     dt: Annotated[Num, Field(gt=0, le=0.1)] = Field(0.001, description="RK4 step, s")
-    log_dt: Pos = Field(0.01, description="logging interval, s (integer multiple of dt)")
+    log_dt: Pos = Field(0.01, description="logging interval, s (integer multiple of dt, divides duration)")
     control_rate: NonNeg = Field(0.0, description="Hz; 0 = continuous (every RK4 stage)")
     theta_limit: Annotated[Num, Field(gt=0, lt=90)] = Field(85.0, description="|pitch| stop, deg")
     state_limit: Pos = Field(1e6, description="abs bound on every state before divergence")
@@ -83,15 +108,28 @@ class SimSection(_Section):
     def _grid(self) -> "SimSection":
         if self.dt > self.duration:
             raise ValueError(f"dt: must be <= duration = {self.duration:g} s (got {self.dt:g})")
+        if _steps_beyond_exact(self.duration, self.dt):
+            return self  # far too many steps: the run plan refuses it, naming limits.max_steps
         if not is_multiple(self.duration, self.dt):
             raise ValueError(f"duration: must be an integer multiple of dt = {self.dt:g} s (got {self.duration:g})")
         if self.log_dt < self.dt:
             raise ValueError(f"log_dt: must be >= dt = {self.dt:g} s (got {self.log_dt:g})")
+        if self.log_dt > self.duration:
+            raise ValueError(f"log_dt: must be <= duration = {self.duration:g} s, so that the log holds the "
+                             f"final state (got {self.log_dt:g})")
         if not is_multiple(self.log_dt, self.dt):
             raise ValueError(f"log_dt: must be an integer multiple of dt = {self.dt:g} s (got {self.log_dt:g})")
-        if self.control_rate > 0 and not is_multiple(1.0 / self.control_rate, self.dt):
-            raise ValueError(f"control_rate: 1/control_rate must be an integer multiple of dt = {self.dt:g} s "
-                             f"(got {self.control_rate:g} Hz, period {1.0 / self.control_rate:g} s)")
+        if self.n_steps % self.log_every != 0:
+            raise ValueError(f"log_dt: must divide duration = {self.duration:g} s into whole logging intervals, "
+                             f"so that the log ends with the final state (got {self.log_dt:g})")
+        if self.control_rate > 0:
+            period = 1.0 / self.control_rate
+            if not math.isfinite(period) or period > self.duration:
+                raise ValueError(f"control_rate: must be >= 1/duration = {1.0 / self.duration:g} Hz, at least "
+                                 f"two control samples per run (got {self.control_rate:g} Hz)")
+            if not is_multiple(period, self.dt):
+                raise ValueError(f"control_rate: 1/control_rate must be an integer multiple of dt = {self.dt:g} s "
+                                 f"(got {self.control_rate:g} Hz, period {period:g} s)")
         return self
 
     @property
@@ -122,9 +160,9 @@ class VehicleSection(_Section):
     """
 
     preset: Str = Field("paper", description="one of auvtrack.plant.presets.available()")
-    m: Pos5 | None = Field(None, description="m11, m22, m33 (kg), m44, m55 (kg m^2)")
-    d: NonNeg5 | None = Field(None, description="d11, d22, d33 (N s/m), d44, d55 (N m s/rad)")
-    wgml: NonNeg | None = Field(None, description="rho g nabla GM_L, N m")
+    m: Mass5 | None = Field(None, description="m11, m22, m33 (kg), m44, m55 (kg m^2)")
+    d: Coefficient5 | None = Field(None, description="d11, d22, d33 (N s/m), d44, d55 (N m s/rad)")
+    wgml: Coefficient | None = Field(None, description="rho g nabla GM_L, N m")
     l: Annotated[Num, Field(gt=0, le=10)] | None = Field(  # noqa: E741 - paper's symbol
         None, description="virtual-point offset ell, m (ell = 0 makes J3 singular)")
 
@@ -182,18 +220,40 @@ class UncertaintySection(_Section):
     G: Fraction = Field(0.0, description="Delta wgml / wgml")
 
 
+# bounds of the initial state, per item: (lo, hi, open interval?, unit)
+ETA0_BOUNDS = ((-1e6, 1e6, False, "m"), (-1e6, 1e6, False, "m"), (-1e6, 1e6, False, "m"),
+               (-math.pi / 2, math.pi / 2, True, "rad"), (-1e3, 1e3, False, "rad"))
+NU0_BOUNDS = ((-100.0, 100.0, False, "m/s"),) * 3 + ((-10.0, 10.0, False, "rad/s"),) * 2
+
+
+def _check_items(values: tuple[float, ...], bounds) -> tuple[float, ...]:
+    for i, (x, (lo, hi, is_open, unit)) in enumerate(zip(values, bounds)):
+        inside = lo < x < hi if is_open else lo <= x <= hi
+        if not inside:
+            a, b = ("(", ")") if is_open else ("[", "]")
+            raise ValueError(f"{i}: must be in {a}{lo:g}, {hi:g}{b} {unit} (got {format_value(x)})")
+    return values
+
+
 class InitialSection(_Section):
-    """``[initial]``: initial state eta(0) = [x, y, z, theta, psi], nu(0) = [u, v, w, q, r]."""
+    """``[initial]``: initial state eta(0) = [x, y, z, theta, psi], nu(0) = [u, v, w, q, r].
+
+    Each item has a physically meaningful range (:data:`ETA0_BOUNDS`, :data:`NU0_BOUNDS`);
+    ``|theta(0)|`` must also be below ``sim.theta_limit``.
+    """
 
     eta: Vec5 = Field((0.0, 0.5, 0.0, 0.0, 0.0), description="m, m, m, rad, rad")
     nu: Vec5 = Field((0.0, 0.0, 0.0, 0.0, 0.0), description="m/s, m/s, m/s, rad/s, rad/s")
 
     @field_validator("eta")
     @classmethod
-    def _pitch(cls, eta: tuple[float, ...]) -> tuple[float, ...]:
-        if not abs(eta[3]) < math.pi / 2:
-            raise ValueError(f"3: pitch theta must satisfy |theta| < pi/2 rad (90 deg) (got {eta[3]:g})")
-        return eta
+    def _eta(cls, eta: tuple[float, ...]) -> tuple[float, ...]:
+        return _check_items(eta, ETA0_BOUNDS)
+
+    @field_validator("nu")
+    @classmethod
+    def _nu(cls, nu: tuple[float, ...]) -> tuple[float, ...]:
+        return _check_items(nu, NU0_BOUNDS)
 
 
 def _inf_words(value: Any) -> Any:
@@ -319,6 +379,23 @@ class OutputSection(_Section):
     mat: Bool = Field(False, description="also write trajectory.mat")
 
 
+class LimitsSection(_Section):
+    """``[limits]``: the largest run the plan accepts (:mod:`auvtrack.scenario.plan`).
+
+    The defaults keep a run to minutes and a couple of GiB; raise them deliberately, e.g.
+    ``--set limits.max_steps=1_000_000_000``.  Each limit has a hard ceiling of its own.
+    """
+
+    max_steps: Annotated[Int, Field(ge=1, le=MAX_EXACT_STEPS)] = Field(
+        100_000_000, description="RK4 steps (sim.duration / sim.dt)")
+    max_log_rows: Annotated[Int, Field(ge=1, le=2 ** 40)] = Field(
+        10_000_000, description="logged rows (sim.duration / sim.log_dt + 1)")
+    max_table_rows: Annotated[Int, Field(ge=1, le=MAX_CURRENT_SAMPLES)] = Field(
+        20_000_000, description="rows of one noise or current table")
+    max_memory_mb: Annotated[Int, Field(ge=1, le=2 ** 30)] = Field(
+        2048, description="estimated peak memory of the run's arrays, MiB")
+
+
 def _check_numbers(model: type[BaseModel], data: dict) -> None:
     """Refuse strings/booleans/non-finite values where ``model`` expects numbers.
 
@@ -379,7 +456,7 @@ class Scenario(BaseModel):
         Run name (folder ``runs/<name>``) and free text.
     seed : int
         Seed of every random stream.
-    sim, vehicle, uncertainty, initial, envelope, estimator, metrics, output, actuator, sensor : section models
+    sim, vehicle, uncertainty, initial, envelope, estimator, metrics, output, actuator, sensor, limits : section models
         The TOML sections of the same names.
     reference : dict
         Resolved reference spec (``kind`` and every field of that kind).
@@ -393,7 +470,7 @@ class Scenario(BaseModel):
 
     name: Str = Field("paper", description="run name (folder runs/<name>)")
     description: Str = ""
-    seed: Annotated[Int, Field(ge=0)] = Field(0, description="seed of every random stream")
+    seed: Annotated[Int, Field(ge=0, le=2 ** 63 - 1)] = Field(0, description="seed of every random stream")
     sim: SimSection = Field(default_factory=SimSection)
     vehicle: VehicleSection = Field(default_factory=VehicleSection)
     uncertainty: UncertaintySection = Field(default_factory=UncertaintySection)
@@ -408,12 +485,20 @@ class Scenario(BaseModel):
     output: OutputSection = Field(default_factory=OutputSection)
     actuator: ActuatorSection = Field(default_factory=ActuatorSection)
     sensor: SensorSection = Field(default_factory=SensorSection)
+    limits: LimitsSection = Field(default_factory=LimitsSection)
 
     @field_validator("name")
     @classmethod
     def _name(cls, v: str) -> str:
-        if not v.strip() or any(c in v for c in "/\\") or v in (".", ".."):
-            raise ValueError(f"must be a non-empty name without '/' or '\\' (got {v!r})")
+        return check_name(v)
+
+    @field_validator("description")
+    @classmethod
+    def _text(cls, v: str) -> str:
+        try:
+            v.encode("utf-8")
+        except UnicodeEncodeError:
+            raise ValueError("must be valid Unicode text (it holds a lone surrogate)") from None
         return v
 
     @field_validator("reference", mode="before")
@@ -438,6 +523,15 @@ class Scenario(BaseModel):
             if model is not None:
                 _check_numbers(model, v)
         return v
+
+    @model_validator(mode="after")
+    def _start_inside_limits(self) -> "Scenario":
+        """A start beyond the pitch limit would stop the run at t = 0."""
+        theta, lim = self.initial.eta[3], self.sim.theta_limit
+        if not abs(theta) < math.radians(lim):
+            raise ValueError(f"initial.eta.3: abs(theta) must be < sim.theta_limit = {lim:g} deg "
+                             f"= {math.radians(lim):.6g} rad (got {format_value(theta)})")
+        return self
 
     @model_validator(mode="after")
     def _sampled_only(self) -> "Scenario":

@@ -28,6 +28,7 @@ from ..plant.presets import vehicle_arrays  # noqa: F401  (re-exported: studies 
 from ..reference import build_reference
 from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
+from ..scenario.plan import plan_run
 from . import engine, kernels
 from .engine import ControllerBundle, EnvironmentBundle, Outputs, PlantBundle, Settings
 from .metrics import METRICS_SIZE, metrics_finalize, metrics_init
@@ -142,13 +143,6 @@ class Prepared:
         return self.plant.x0.size + self.controller.x0.size
 
 
-def _steps(value: float, dt: float, name: str) -> int:
-    n = round(value / dt)
-    if n < 1 or abs(n * dt - value) > 1e-9 * max(1.0, value):
-        raise ValueError(f"{name} ({value}) must be a positive integer multiple of sim.dt ({dt})")
-    return n
-
-
 def _c(a) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
@@ -171,7 +165,8 @@ def prepare(scenario: Scenario) -> Prepared:
     ------
     ValueError
         If the plant or the controller refuses the set-up (e.g. a start on the envelope with the
-        treatment off), naming the field.
+        treatment off), naming the field, or the run plan exceeds the scenario's ``[limits]``
+        (:class:`~auvtrack.scenario.ScenarioError`, :func:`auvtrack.scenario.plan.plan_run`).
     """
     sc = scenario
     plant_spec = get_plant(sc.plant.model) if hasattr(sc, "plant") else get_plant("5dof")
@@ -179,7 +174,6 @@ def prepare(scenario: Scenario) -> Prepared:
     vp_nom, _, _ = vehicle_arrays(sc)
     ref = build_reference(dict(sc.reference))
     ref_p = ref.pack()
-    tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     eta0 = np.array(sc.initial.eta, dtype=float)
     p0, v0, a0 = ref.evaluate(0.0)
     refm0 = np.vstack([p0, v0, a0])
@@ -188,10 +182,11 @@ def prepare(scenario: Scenario) -> Prepared:
                        dt=sc.sim.dt, control_rate=sc.sim.control_rate)
     cspec = get_controller(sc.controller.kind)
     cc = cspec.setup(sc, ctx)
+    channels = BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names)
+    plan = plan_run(sc, len(channels))  # every size checked against [limits] before any allocation
+    tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     dt = sc.sim.dt
-    n_steps = _steps(sc.sim.duration, dt, "sim.duration")
-    log_every = _steps(sc.sim.log_dt, dt, "sim.log_dt")
-    ctrl_every = 0 if sc.sim.control_rate == 0 else _steps(1.0 / sc.sim.control_rate, dt, "1/sim.control_rate")
+    n_steps, log_every, ctrl_every = plan.n_steps, plan.log_every, plan.control_every
     naux = len(cc.aux_names)
     si = np.array([n_steps, log_every, ctrl_every, naux], dtype=np.int64)
     t0, t1 = sc.metrics.window
@@ -202,7 +197,7 @@ def prepare(scenario: Scenario) -> Prepared:
     sigma = (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu)
     if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
-    noise = noise_table(sc.seed, n_steps // ctrl_every + 1 if ctrl_every else 1, sigma)
+    noise = noise_table(sc.seed, plan.control_samples if ctrl_every else 1, sigma)
     key = kernels.KernelKey(cc.law or cspec.module, plant_spec.module, f"{cspec.name} on {plant_spec.name}")
     return Prepared(
         scenario=sc, key=key,
@@ -210,8 +205,8 @@ def prepare(scenario: Scenario) -> Prepared:
         controller=ControllerBundle(_c(cc.cp), _c(cc.xc0), _c(vp_nom)),
         environment=EnvironmentBundle(_c(tables.rows), _c(tables.current), _c(noise)),
         ref_p=_c(ref_p), settings=Settings(si, sf),
-        n_rows=n_steps // log_every + 1,
-        channels=BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names),
+        n_rows=plan.log_rows,
+        channels=channels,
         notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[ELL])] if n),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": cc.resolved},
@@ -262,21 +257,28 @@ def call_kernel(prep: Prepared, out: Outputs) -> tuple[int, int, float]:
 
 
 def _in_worker_thread(fn, stop: np.ndarray):
-    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag."""
+    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag.
+
+    The wait is on an Event, not on ``Thread.join``: a ``join`` interrupted by Ctrl-C can report
+    the thread finished while it still runs (CPython 3.11), and the result would be lost.
+    """
     box: dict[str, Any] = {}
+    done = threading.Event()
 
     def target():
         try:
             box["value"] = fn()
         except BaseException as exc:  # pragma: no cover - re-raised below
             box["error"] = exc
+        finally:
+            done.set()
 
     th = threading.Thread(target=target, name="auvtrack-run", daemon=True)
     th.start()
     interrupted = False
-    while th.is_alive():
+    while not done.is_set():
         try:
-            th.join(0.05)
+            done.wait(0.05)
         except KeyboardInterrupt:
             stop[engine.INFO_STOP] = 1
             interrupted = True

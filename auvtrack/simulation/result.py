@@ -1,19 +1,27 @@
 """The outcome of one simulation: logged channels, metrics, status, and the run-folder format.
 
 A run folder holds ``trajectory.csv`` (bit-exact text), ``run.json`` (scenario, status, failure,
-metrics, meta) and optionally ``trajectory.mat``; ``docs/metrics.md`` is the contract.
+metrics, meta), ``scenario.toml`` (the fully resolved scenario: ``auvtrack run`` on it reproduces
+``trajectory.csv`` byte for byte) and optionally ``trajectory.mat``; ``docs/metrics.md`` is the
+contract.  A folder is written whole under a unique temporary name and renamed into place
+(:mod:`auvtrack._atomic`), so it is always one run's complete output, even when several runs
+write to the same folder at once.
 """
 from __future__ import annotations
 
+import hashlib
+import itertools
 import json
 import math
 import os
 import re
+import shutil
 from pathlib import Path
-from typing import Any, Iterator, Mapping
+from typing import Any, BinaryIO, Iterator, Mapping
 
 import numpy as np
 
+from .._atomic import FolderError, make_temp_folder, open_exclusive, publish_folder, publish_new_folder
 from .channels import current_name, legacy_columns, upgrade_names
 
 BASE_CHANNELS: tuple[str, ...] = ("t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r",
@@ -22,7 +30,10 @@ BASE_CHANNELS: tuple[str, ...] = ("t", "x", "y", "z", "theta", "psi", "u", "v", 
 
 STATUSES = ("ok", "failed", "interrupted")
 FAILURE_KEYS = ("time", "cause", "detail", "state")
-CSV_NAME, JSON_NAME, MAT_NAME = "trajectory.csv", "run.json", "trajectory.mat"
+CSV_NAME, JSON_NAME, MAT_NAME, TOML_NAME = "trajectory.csv", "run.json", "trajectory.mat", "scenario.toml"
+RUN_FILES = (CSV_NAME, JSON_NAME, TOML_NAME, MAT_NAME)
+"""The only entries of a run folder; an existing folder holding anything else is never replaced."""
+CSV_BLOCK_ROWS = 2000  # rows formatted at a time: the CSV writer's memory does not grow with the run
 MAT_RESERVED = ("channel_names", "scenario_json", "failure_json", "status", "metrics", "version")
 _NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,62}$")  # also a valid MATLAB variable name
 
@@ -110,13 +121,134 @@ def restore_nonfinite(doc: Any, nonfinite: Mapping[str, str]) -> Any:
     return doc
 
 
-def _atomic_write(path: Path, data: str | bytes) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    if isinstance(data, str):
-        tmp.write_text(data, encoding="utf-8", newline="\n")
-    else:
-        tmp.write_bytes(data)
-    os.replace(tmp, path)
+def _name_max(folder: Path) -> int:
+    try:
+        return os.pathconf(folder if folder.is_dir() else ".", "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255
+
+
+def run_folder_problem(folder: str | os.PathLike) -> str | None:
+    """Why ``folder`` cannot become a run folder, or None when it can (absent, empty or a run folder).
+
+    Parameters
+    ----------
+    folder : str or path-like
+        The intended run folder.
+
+    Returns
+    -------
+    str or None
+        One line naming the folder and the problem: a NUL character or an over-long name, a
+        file or a symbolic link at that path, or a folder holding entries other than
+        :data:`RUN_FILES` (which would be lost when the run replaces it).
+    """
+    text = os.fspath(folder)
+    if "\x00" in text:
+        return f"{text!r}: a path cannot contain a NUL character"
+    if not text.strip():
+        return "the run folder path is empty"
+    path = Path(text)
+    if path.name in ("", ".", ".."):
+        return f"{text}: must name a folder of its own (not '.', '..' or '/')"
+    limit = _name_max(path.parent)
+    long = [p for p in path.parts if len(p.encode("utf-8", "surrogateescape")) > limit]
+    if long:
+        return f"{text}: the name {long[0][:40]!r}... is longer than {limit} bytes"
+    if path.is_symlink():
+        return f"{text}: is a symbolic link; give the folder itself"
+    if path.exists() and not path.is_dir():
+        return f"{text}: is a file, not a folder"
+    if path.is_dir():
+        try:
+            foreign = sorted(e for e in os.listdir(path) if e not in RUN_FILES)
+        except OSError as exc:
+            return f"{text}: cannot be read ({exc.strerror or exc})"
+        if foreign:
+            shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+            return (f"{text}: holds {len(foreign)} entr{'y' if len(foreign) == 1 else 'ies'} that a run folder "
+                    f"does not ({shown}); choose an empty folder or a run folder")
+    return None
+
+
+def prepare_run_folder(folder: str | os.PathLike) -> Path:
+    """Check that a run can be written to ``folder``, before the run: create its parents, test writing.
+
+    Parameters
+    ----------
+    folder : str or path-like
+        The intended run folder.
+
+    Returns
+    -------
+    pathlib.Path
+        ``folder`` as a path.
+
+    Raises
+    ------
+    FolderError
+        One line: see :func:`run_folder_problem`, or a parent that cannot be created or written.
+    """
+    problem = run_folder_problem(folder)
+    if problem is not None:
+        raise FolderError(problem)
+    path = Path(folder)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        make_temp_folder(path).rmdir()
+    except OSError as exc:
+        where = exc.filename if isinstance(exc.filename, str) else path.parent
+        raise FolderError(f"{os.fspath(folder)}: cannot write there ({where}: {exc.strerror or exc})") from None
+    return path
+
+
+def verify_run_folder(folder: str | os.PathLike) -> list[str]:
+    """Check that a run folder is one run's complete output: every file ``run.json`` lists matches.
+
+    Parameters
+    ----------
+    folder : str or path-like
+        A folder written by :meth:`Result.save`.
+
+    Returns
+    -------
+    list of str
+        Problems found (empty: consistent): a missing or unreadable ``run.json``, a listed file
+        missing or with another SHA-256 or size, an entry that is not a run-folder file.
+    """
+    path = Path(folder)
+    try:
+        doc = json.loads((path / JSON_NAME).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        return [f"{JSON_NAME}: cannot be read ({exc})"]
+    problems = []
+    for name, rec in (doc.get("files") or {}).items():
+        try:
+            data = (path / name).read_bytes()
+        except OSError as exc:
+            problems.append(f"{name}: missing ({exc.strerror or exc})")
+            continue
+        if len(data) != rec.get("bytes") or hashlib.sha256(data).hexdigest() != rec.get("sha256"):
+            problems.append(f"{name}: does not match the SHA-256 and size recorded in {JSON_NAME}")
+    extra = sorted(e for e in os.listdir(path) if e not in RUN_FILES)
+    if extra:
+        problems.append(f"entries that are not run-folder files: {', '.join(extra)}")
+    return problems
+
+
+class _HashingWriter:
+    """A binary file wrapper that also computes the SHA-256 and size of what is written."""
+
+    def __init__(self, fh: BinaryIO) -> None:
+        self.fh, self.sha, self.size = fh, hashlib.sha256(), 0
+
+    def write(self, data: bytes) -> None:
+        self.fh.write(data)
+        self.sha.update(data)
+        self.size += len(data)
+
+    def record(self) -> dict[str, Any]:
+        return {"sha256": self.sha.hexdigest(), "bytes": self.size}
 
 
 # ---------------------------------------------------------------- Result
@@ -132,8 +264,8 @@ class Result:
         be identifiers of at most 63 characters (valid CSV headers and MATLAB variables).
     scenario : mapping
         The resolved scenario (JSON-compatible dict).
-    status : {"ok", "failed"}
-        Outcome of the run.
+    status : {"ok", "failed", "interrupted"}
+        Outcome of the run (``"interrupted"``: stopped by the user, e.g. Ctrl-C).
     failure : dict or None
         ``None`` for an ``ok`` run, else ``{"time", "cause", "detail", "state"}``.
     metrics : mapping of str to float
@@ -321,52 +453,116 @@ class Result:
         return plot_runs(kind, [(label, self)], **kw)
 
     # ---- run folder
-    def _json_document(self) -> str:
+    def _json_document(self, files: Mapping[str, Any] | None = None) -> str:
         nonfinite: dict[str, str] = {}
         doc = {"version": self.version, "status": self.status}
         body = {"failure": self.failure, "metrics": self.metrics, "scenario": self.scenario, "meta": self.meta}
         for key, value in body.items():
             doc[key] = to_jsonable(value, nonfinite, f"/{key}")
         doc["nonfinite"] = nonfinite
+        if files is not None:
+            doc["files"] = dict(files)
         return json.dumps(doc, indent=2, allow_nan=False, ensure_ascii=False) + "\n"
 
-    def _csv_text(self) -> str:
-        # repr of a Python float is the shortest string that round-trips bit-exactly
-        cols = [list(map(repr, v.tolist())) for v in self._ch.values()]
-        rows = [",".join(r) + "\n" for r in zip(*cols)]
-        return ",".join(self._ch) + "\n" + "".join(rows)
+    def _write_csv(self, fh) -> None:
+        """Stream the CSV in blocks of :data:`CSV_BLOCK_ROWS` rows (memory flat in the run length)."""
+        fh.write((",".join(self._ch) + "\n").encode("utf-8"))
+        arrays = list(self._ch.values())
+        for start in range(0, len(self), CSV_BLOCK_ROWS):
+            # repr of a Python float is the shortest string that round-trips bit-exactly
+            cols = [list(map(repr, v[start:start + CSV_BLOCK_ROWS].tolist())) for v in arrays]
+            fh.write("".join(",".join(r) + "\n" for r in zip(*cols)).encode("utf-8"))
 
-    def save(self, out_dir: str | os.PathLike, mat: bool = False) -> Path:
-        """Write the run folder: ``trajectory.csv``, ``run.json`` and optionally ``trajectory.mat``.
+    def _csv_text(self) -> str:
+        import io
+
+        buf = io.BytesIO()
+        self._write_csv(buf)
+        return buf.getvalue().decode("utf-8")
+
+    def scenario_toml(self) -> str | None:
+        """The run's scenario as TOML (``scenario.toml``), or None for a result without a scenario.
+
+        Returns
+        -------
+        str or None
+            The resolved scenario without the derived ``resolved`` record (which ``run.json``
+            keeps); ``auvtrack run`` accepts it as is.
+        """
+        from ..scenario.toml_writer import dumps
+
+        doc = {k: v for k, v in self.scenario.items() if k != "resolved"}
+        if not doc:
+            return None
+        header = (f"Fully resolved scenario of this run (auvtrack {self.version}).\n"
+                  "`auvtrack run scenario.toml` reproduces trajectory.csv byte for byte\n"
+                  "(same auvtrack version and machine); see docs/scenarios.md.")
+        return dumps(doc, header=header)
+
+    def save(self, out_dir: str | os.PathLike, mat: bool = False, *, overwrite: bool = True) -> Path:
+        """Write the run folder: ``trajectory.csv``, ``run.json``, ``scenario.toml``, optionally ``trajectory.mat``.
 
         Parameters
         ----------
         out_dir : str or path
-            Folder to create (parents too) or overwrite.
+            The run folder.  Its parents are created; an existing folder is replaced as a whole,
+            and only if it is empty or holds nothing but run-folder files (:data:`RUN_FILES`).
         mat : bool, optional
-            Also write ``trajectory.mat`` (MATLAB v5); otherwise a stale one is removed.
+            Also write ``trajectory.mat`` (MATLAB v5).
+        overwrite : bool, optional
+            False: never replace a folder; when ``out_dir`` is taken (by the time the run is
+            published), use the first free ``<out_dir>-2``, ``-3``, ... instead (the default run
+            folders of ``auvtrack run``).
 
         Returns
         -------
         pathlib.Path
-            The folder.
+            The folder written (``out_dir``, or a numbered sibling with ``overwrite=False``).
+
+        Raises
+        ------
+        FolderError
+            ``out_dir`` is a file, a symbolic link, a folder holding other files, or cannot be
+            written (checked before anything is written; :func:`prepare_run_folder`).
 
         Notes
         -----
+        The files are written into a new, uniquely named folder next to ``out_dir`` (created
+        exclusively: no existing file or symlink is ever opened) and that folder is renamed into
+        place atomically, so ``out_dir`` is always absent or one run's complete output, even
+        when several runs save to it at once (the last one to finish wins).  ``run.json`` records
+        the SHA-256 and size of the other files under ``"files"``.
+
         CSV values are Python float reprs (``nan``, ``inf`` spelled so): loading gives the same
         bits, and identical results give byte-identical files.  In ``run.json`` every non-finite
         float is written as ``null`` and its JSON pointer recorded under ``"nonfinite"``
         (e.g. ``{"/metrics/settle_1mm_x": "inf"}``) so that :meth:`load` restores it.
         """
-        folder = Path(out_dir)
-        folder.mkdir(parents=True, exist_ok=True)
-        _atomic_write(folder / CSV_NAME, self._csv_text())
-        _atomic_write(folder / JSON_NAME, self._json_document())
-        mat_path = folder / MAT_NAME
-        if mat:
-            self._save_mat(mat_path)
-        elif mat_path.exists():
-            mat_path.unlink()
+        folder = prepare_run_folder(out_dir)
+        tmp = make_temp_folder(folder)
+        try:
+            files: dict[str, Any] = {}
+            with open_exclusive(tmp / CSV_NAME) as fh:
+                w = _HashingWriter(fh)
+                self._write_csv(w)
+                files[CSV_NAME] = w.record()
+            toml = self.scenario_toml()
+            if toml is not None:
+                data = toml.encode("utf-8")
+                with open_exclusive(tmp / TOML_NAME) as fh:
+                    fh.write(data)
+                files[TOML_NAME] = {"sha256": hashlib.sha256(data).hexdigest(), "bytes": len(data)}
+            if mat:
+                self._save_mat(tmp / MAT_NAME)
+            with open_exclusive(tmp / JSON_NAME) as fh:
+                fh.write(self._json_document(files).encode("utf-8"))
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        if not overwrite:
+            return publish_new_folder(tmp, (folder if n == 1 else folder.with_name(f"{folder.name}-{n}")
+                                            for n in itertools.count(1)))
+        publish_folder(tmp, folder, run_folder_problem)
         return folder
 
     def _save_mat(self, path: Path) -> None:
@@ -385,10 +581,8 @@ class Result:
         mdict["status"] = self.status
         mdict["version"] = self.version
         mdict["metrics"] = {k: float(v) for k, v in self.metrics.items()}
-        tmp = path.with_name(path.name + ".tmp")
-        with open(tmp, "wb") as f:
+        with open_exclusive(path) as f:
             savemat(f, mdict, oned_as="column")
-        os.replace(tmp, path)
 
     @classmethod
     def load(cls, run_dir: str | os.PathLike) -> "Result":
@@ -430,4 +624,5 @@ class Result:
                    doc.get("metrics") or {}, doc.get("meta"), version=doc.get("version"))
 
 
-__all__ = ["Result", "BASE_CHANNELS", "to_jsonable", "restore_nonfinite"]
+__all__ = ["Result", "BASE_CHANNELS", "RUN_FILES", "to_jsonable", "restore_nonfinite", "run_folder_problem",
+           "prepare_run_folder", "verify_run_folder", "FolderError"]

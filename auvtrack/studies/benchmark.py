@@ -18,6 +18,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from .._atomic import atomic_file
 from ..runner import compare as runner
 from . import leaderboard as lb
 from .suite import DEFAULT_SUITE, CRITERIA, ControllerEntry, Suite, load_suite, resolve_controllers
@@ -190,7 +191,8 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
         return CompareOutcome(folder, False, None, ex, 0.0)
     t0 = time.perf_counter()
     df = lb.derive_metrics(runner.read_runs(folder), s.file.metrics.settle)
-    df.to_parquet(folder / runner.RUNS_FILE, index=False)
+    with atomic_file(folder / runner.RUNS_FILE) as fh:  # the runs with the benchmark's metrics
+        df.to_parquet(fh, index=False)
     analysis = analyse(df, s)
     seeds = representative_seeds(df)
     reps = _representative_runs(s, ents, seeds, workers)
