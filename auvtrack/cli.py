@@ -205,7 +205,8 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 
 
 @cli.command()
-@click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: ftsmc, fxtntsmc).")
+@click.option("--controller", "controllers", multiple=True,
+              help="Controller kind(s), or plugin:FILE.py (default: every built-in controller).")
 @click.option("--repeat", default=7, show_default=True, help="Timed repetitions; the median is reported.")
 @click.option("--duration", default=20.0, show_default=True, help="Simulated seconds per repetition.")
 @click.option("--all", "run_all", is_flag=True,
@@ -215,13 +216,11 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
               help="Folder for the --all results (default: a new folder under ~/.local/share/auvtrack/bench, "
                    "or $XDG_DATA_HOME; never the source tree unless asked, e.g. --out benchmarks).")
 def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
-    """Time the compiled closed loop: µs per RK4 step, one JSON line per controller.
+    """Time the compiled closed loop: µs per RK4 step, one JSON line per controller (every built-in by default).
 
     --all runs the full suite (batch runs/s, Dask sweep throughput) and writes results.json and
     results.md to --out (default: a new user folder; the working tree is left unchanged).
     """
-    from .runner.bench import bench_single
-
     if not 1 <= repeat <= MAX_REPEAT:
         raise BadInput(f"--repeat: must be in [1, {MAX_REPEAT}] (a median needs at least one timing) (got {repeat})")
     if not duration > 0:
@@ -235,8 +234,10 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
         click.echo(json.dumps(doc, indent=2))
         click.echo(f"written: {folder / 'results.json'}, {folder / 'results.md'}")
         return
-    for kind in controllers or ("ftsmc", "fxtntsmc"):
-        click.echo(json.dumps(bench_single(kind, repeat=repeat, duration=duration)))
+    from .runner.bench import bench_singles, builtin_controllers
+
+    for row in bench_singles(controllers or builtin_controllers(), repeat=repeat, duration=duration):
+        click.echo(json.dumps(row))
 
 
 @cli.command()

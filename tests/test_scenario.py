@@ -217,7 +217,7 @@ BAD = [
     ({"sim": {"duration": 0.0005}}, "sim.dt", "must be <= duration"),
     ({"sim": {"control_rate": 300}}, "sim.control_rate", "integer multiple of dt"),
     ({"vehicle": {"preset": "nautilus"}}, "vehicle.preset", "unknown preset (allowed: paper"),
-    ({"controller": {"kind": "pid"}}, "controller.kind", "unknown kind (allowed: 'fxtntsmc', 'ftsmc'"),
+    ({"controller": {"kind": "lqr"}}, "controller.kind", "unknown kind (allowed: 'fxtntsmc', 'ftsmc'"),
     ({"reference": {"kind": "spiral"}}, "reference.kind", "spiral"),
     ({"reference": {"radius": -4}}, "reference.radius", "(got -4"),
     ({"disturbance": [{"kind": "paper", "amplitude": -1}]}, "disturbance.0.amplitude", "got -1"),
@@ -318,8 +318,12 @@ def test_controller_union_covers_registry():
 
     kinds = {m.model_fields["kind"].default for m in CONTROLLER_MODELS}
     assert kinds == set(CONTROLLERS)
-    for kind in kinds:
-        assert load_scenario({}, [f"controller.kind={kind}"]).controller.kind == kind
+    example = Path(__file__).resolve().parents[1] / "examples" / "plugin_controller.py"
+    for kind in kinds:  # a plug-in needs its module
+        extra = [f"controller.module=\"{example}\""] if kind == "plugin" else []
+        assert load_scenario({}, [f"controller.kind={kind}", *extra]).controller.kind == kind
+    with pytest.raises(ScenarioError, match="controller.module: required key is missing"):
+        load_scenario({}, ["controller.kind=plugin"])
 
 
 def test_frozen():

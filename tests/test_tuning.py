@@ -74,17 +74,17 @@ def test_budget_and_seed_are_respected(monkeypatch):
 
 def test_unknown_kind_is_one_line_error():
     with pytest.raises(ValueError, match="kind: must be one of"):
-        tuning.tune("pid", TINY)
+        tuning.tune("open_loop", TINY)
 
 
-@pytest.mark.parametrize("kind", ["ftsmc", "fxtntsmc"])
+@pytest.mark.parametrize("kind", sorted(tuning.SPACES))
 def test_tuned_presets_load_validate_and_apply(kind):
     name = f"{kind}_tuned"
     assert name in available_gain_presets()
     pre = get_gain_preset(name)
     assert pre.kind == kind
     assert set(pre.gains) == set(tuning.SPACES[kind].names)
-    assert pre.provenance["evaluations"] == tuning.FULL.max_evaluations
+    assert pre.provenance["evaluations"] == tuning.FULL.max_evaluations  # 360 for 3 gains as for 4
     sc = load_scenario({"controller": {"preset": name}})
     assert sc.controller.kind == kind
     assert "preset" not in sc.to_dict()["controller"]  # expanded at load time
@@ -118,9 +118,27 @@ def test_quick_study_end_to_end(tmp_path):
     assert "tuning" in all_studies()
     report = tuning.run(tmp_path, quick=True)
     text = report.read_text()
-    assert report.name == "report.md" and "| ftsmc | tuned |" in text and "| fxtntsmc | tuned |" in text
-    for kind in ("ftsmc", "fxtntsmc"):
+    assert report.name == "report.md"
+    for kind, space in tuning.SPACES.items():
+        assert f"| {kind} | tuned |" in text
         raw = tomllib.loads((tmp_path / f"{kind}_tuned.toml").read_text())
-        assert raw["kind"] == kind and raw["provenance"]["evaluations"] == tuning.QUICK.max_evaluations
+        assert raw["kind"] == kind
+        assert raw["provenance"]["evaluations"] == tuning.QUICK.evaluations(len(space.names))
         load_scenario({"controller": {"kind": kind, **raw["gains"]}})
     assert (tmp_path / "results.json").exists()
+
+
+def test_every_controller_gets_the_same_budget():
+    """24 candidates per generation whether a controller tunes three gains or four: 360 gain vectors."""
+    for space in tuning.SPACES.values():
+        n = len(space.names)
+        assert tuning.FULL.de_popsize(n) * n == tuning.FULL.population == 24
+        assert tuning.FULL.evaluations(n) == tuning.FULL.max_evaluations == 360
+
+
+def test_gains_the_controller_refuses_are_an_error_the_objective_penalises():
+    case = tuning.TRAIN_CASES[0]
+    with pytest.raises(ValueError, match="controller.ki"):  # ki >= kd kp: not Hurwitz
+        tuning.run_cost(case, "pid", {"kp": 1.0, "ki": 5.0, "kd": 1.0}, 1.0, 0.002, tuning.Objective())
+    with pytest.raises(ValueError, match="controller.k2"):  # below the Moreno-Osorio bound
+        tuning.run_cost(case, "sta", {"lam": 1.0, "k1": 1.0, "k2": 0.05}, 1.0, 0.002, tuning.Objective())

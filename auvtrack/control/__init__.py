@@ -1,18 +1,24 @@
 """Controllers: registry, shared tracking kinematics and the compiled laws.
 
-Registering a built-in controller is one line: its module in :data:`BUILTIN`.
+Registering a built-in controller is one line: its module in :data:`BUILTIN`.  ``plugin`` is
+registered after them: it is the loader of controllers from outside the package (kind ``"plugin"``).
 """
-from . import ftsmc, fxtntsmc, open_loop
+from . import backstepping, ftsmc, fxtntsmc, open_loop, pid, plugin, ppc, sta
 from .params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
 from .registry import CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, get, register
 
 BUILTIN = (
     fxtntsmc,
     ftsmc,
+    pid,
+    backstepping,
+    sta,
+    ppc,
     open_loop,
 )
 for _module in BUILTIN:
     register(ControllerSpec.from_module(_module))
+register(ControllerSpec.from_module(plugin))
 
 __all__ = ["BUILTIN", "CONTROLLERS", "CompiledController", "ControllerParams", "ControllerSpec", "get",
            "register", "FTSMCParams", "FXTNTSMCParams", "OpenLoopParams"]

@@ -50,6 +50,8 @@ class CompiledController:
     law : str
         Where the compiled ``control`` lives: an importable module name or a ``.py`` file path.
         Empty: the registered module's (plug-ins set it to their file).
+    statuses : dict of int to str
+        Messages of status codes beyond the registered module's ``STATUS`` (a plug-in's own).
     """
 
     cp: np.ndarray
@@ -58,6 +60,7 @@ class CompiledController:
     notes: tuple[str, ...] = ()
     resolved: dict[str, Any] = field(default_factory=dict)
     law: str = ""
+    statuses: dict[int, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 
+from .. import _jit
 from ..scenario import paper_scenario_path
 
 PAPER = paper_scenario_path()
@@ -35,11 +36,58 @@ def machine() -> dict:
             "numba": numba.__version__, "load_avg_1_5_15": load, "vector_math": BACKEND}
 
 
+def builtin_controllers() -> tuple[str, ...]:
+    """Kinds of the built-in controllers (``auvtrack.control.BUILTIN``; the plug-in loader is not one)."""
+    from ..control import BUILTIN
+
+    return tuple(m.NAME for m in BUILTIN)
+
+
+def plugin_copy(kind: str, folder: Path) -> Path:
+    """Write built-in controller ``kind``'s module as a stand-alone plug-in file (absolute imports).
+
+    The same law through the plug-in path (``controller.kind = "plugin"``), for timing a plug-in
+    against the built-in it copies.
+
+    Parameters
+    ----------
+    kind : str
+        A built-in controller.
+    folder : pathlib.Path
+        Where to write ``copy_of_<kind>.py``.
+
+    Returns
+    -------
+    pathlib.Path
+        The plug-in file.
+    """
+    import importlib
+    import re
+
+    from ..control import get
+
+    src = Path(importlib.import_module(get(kind).module).__file__).read_text()
+    src = re.sub(r"^from \.\.(\w+)", r"from auvtrack.\1", src, flags=re.M)
+    src = re.sub(r"^from \.(\w+)", r"from auvtrack.control.\1", src, flags=re.M)
+    src = re.sub(r"^from \. import", "from auvtrack.control import", src, flags=re.M)
+    path = Path(folder) / f"copy_of_{kind}.py"
+    if not (path.is_file() and path.read_text() == src):  # unchanged: keep it (and its cached kernel)
+        path.write_text(src)
+    return path
+
+
+def _overrides(kind: str) -> list[str]:
+    """Scenario overrides of a bench row: a kind, or ``plugin:<file>`` for a plug-in."""
+    if kind.startswith("plugin:"):
+        return [f'controller={{kind="plugin", module="{kind[len("plugin:"):]}"}}']
+    return [f"controller.kind={kind}"]
+
+
 def _prepared(kind: str, duration: float):
     from ..scenario import load_scenario
     from ..simulation.api import prepare
 
-    return prepare(load_scenario(PAPER, [f"controller.kind={kind}", f"sim.duration={duration}"]))
+    return prepare(load_scenario(PAPER, _overrides(kind) + [f"sim.duration={duration}"]))
 
 
 def bench_single(kind: str, *, repeat: int = 7, duration: float = 20.0) -> dict:
@@ -52,7 +100,7 @@ def bench_single(kind: str, *, repeat: int = 7, duration: float = 20.0) -> dict:
 
 
 def bench_singles(kinds: tuple[str, ...], *, repeat: int = 7, duration: float = 20.0) -> list[dict]:
-    """:func:`bench_single` for several controllers, their repetitions interleaved.
+    """:func:`bench_single` for several controllers (``plugin:<file>`` for a plug-in), their repetitions interleaved.
 
     Round-robin timing: on a shared machine whose speed drifts for seconds at a time, a slow
     spell then lands on every controller alike instead of on one, so the ratios stay meaningful.
@@ -104,7 +152,7 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     from ..simulation import kernels
 
     keys = [kernels.KernelKey(CONTROLLERS[c].module, PLANTS[p].module, f"{c} on {p}")
-            for c in (controllers or tuple(CONTROLLERS)) for p in (plants or tuple(PLANTS))]
+            for c in (controllers or builtin_controllers()) for p in (plants or tuple(PLANTS))]
     t0 = time.perf_counter()
     done = kernels.warmup(keys, progress=progress)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
@@ -161,7 +209,13 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     say = print if progress else (lambda *a, **k: None)
     mach = machine()  # load average before our own runs
     say("single runs")
-    single = bench_singles(("open_loop", "ftsmc", "fxtntsmc"), repeat=3 * repeat, duration=20.0)
+    folder = _jit.cache_dir() / "bench_plugins"  # a fixed place: the plug-in kernels stay cached
+    folder.mkdir(parents=True, exist_ok=True)
+    copies = tuple(f"plugin:{plugin_copy(k, folder)}" for k in ("ftsmc", "fxtntsmc"))  # the paper's laws as plug-ins
+    single = bench_singles(builtin_controllers() + copies, repeat=3 * repeat, duration=20.0)
+    for row in single:
+        if row["controller"].startswith("plugin:"):
+            row["controller"] = Path(row["controller"]).stem.replace("copy_of_", "") + " (plug-in copy)"
     say("breakdown")
     breakdown = bench_breakdown(repeat=repeat)
     say("batch")
@@ -175,4 +229,5 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     return {**doc, "out": out}
 
 
-__all__ = ["bench_single", "bench_singles", "bench_all", "user_bench_folder", "warmup", "machine"]
+__all__ = ["bench_single", "bench_singles", "bench_all", "user_bench_folder", "warmup", "machine",
+           "builtin_controllers", "plugin_copy"]

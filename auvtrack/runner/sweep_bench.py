@@ -195,6 +195,10 @@ def write_results(doc: dict, out: Path) -> None:
     lines += ["", f"FXTNTSMC / FTSMC: {single['fxtntsmc']['cpu_us_per_step'] / single['ftsmc']['cpu_us_per_step']:.2f} "
               f"(CPU time); open_loop is the engine alone (plant, reference, disturbance, metrics) plus three sines.",
               ""]
+    lines += [f"{k} as a plug-in (the module copied to a file, `controller.kind = \"plugin\"`) / built-in: "
+              f"{single[f'{k} (plug-in copy)']['cpu_us_per_step'] / single[k]['cpu_us_per_step']:.2f} (CPU time)."
+              for k in ("ftsmc", "fxtntsmc") if f"{k} (plug-in copy)" in single and k in single]
+    lines += [""] if any("(plug-in copy)" in k for k in single) else []
     if doc.get("breakdown"):
         lines += ["## Where the time goes (median CPU µs per RK4 step, metrics only, 5 s runs)", "",
                   "| variant | CPU µs / step |", "|---|---|"]

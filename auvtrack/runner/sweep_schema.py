@@ -255,8 +255,10 @@ def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
     from ..scenario import paper_scenario_path
 
     path = paper_scenario_path() if study.scenario == PAPER_SCENARIO else (folder / study.scenario)
+    from ..control.plugin import anchor_module
+
     try:
-        raw = read_toml(path)
+        raw = anchor_module(read_toml(path), Path(path).parent)  # a plug-in path: relative to its file
     except ScenarioError as exc:
         raise _fail(source, "scenario", f"must be 'paper' or a readable scenario TOML file ({exc})") from None
     try:

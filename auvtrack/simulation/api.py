@@ -210,7 +210,7 @@ def prepare(scenario: Scenario) -> Prepared:
         notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[ELL])] if n),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": cc.resolved},
-        statuses={**CONTROLLER_STATUS, **cspec.statuses},
+        statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
     )
 
 

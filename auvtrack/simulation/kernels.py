@@ -76,8 +76,13 @@ class KernelKey:
             path = Path(self.law).resolve()
             digest = hashlib.sha256(path.read_bytes()).hexdigest()[:12]
             law = f"plugin_{_ident(path.stem)}_{digest}"
-        else:
+        elif self.law.startswith("auvtrack."):
             law = _ident(self.law.rsplit(".", 1)[-1])
+        else:  # a plug-in given by module name: its full name and the hash of its file
+            spec = importlib.util.find_spec(self.law)
+            origin = Path(spec.origin) if spec is not None and spec.origin else None
+            digest = hashlib.sha256(origin.read_bytes()).hexdigest()[:12] if origin and origin.is_file() else "0"
+            law = f"plugin_{_ident(self.law)}_{digest}"
         return f"k_{law}__{_ident(self.plant.rsplit('.', 1)[-1])}"
 
 

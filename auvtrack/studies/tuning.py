@@ -1,9 +1,10 @@
-"""``auvtrack study tuning``: fair tuning of the FTSMC baseline and of the FXTNTSMC.
+"""``auvtrack study tuning``: fair tuning of every built-in closed-loop controller.
 
-Both controllers get the **same** optimiser (SciPy ``differential_evolution``, fixed seed,
-fixed population and generation count, no gradient polish), the **same** budget (four gains
-each, the same number of closed-loop evaluations), the **same** objective and the **same**
-training scenarios (Section 4 and two variations).  The tuned gains are then evaluated on
+Every controller (the paper's FXTNTSMC and the baselines FTSMC, PID, backstepping, STA and PPC)
+gets the **same** optimiser (SciPy ``differential_evolution``, fixed seed, fixed population and
+generation count, no gradient polish), the **same** budget (24 candidates per generation, the
+same number of closed-loop evaluations whether it tunes three gains or four), the **same**
+objective and the **same** training scenarios (Section 4 and two variations).  The tuned gains are then evaluated on
 held-out scenarios that the optimiser never saw, and written as gain presets
 (``auvtrack/data/gains/<kind>_tuned.toml`` shape) usable from any scenario as
 ``controller.preset``.  Procedure, numbers and how to rerun: ``docs/tuning.md``.
@@ -15,7 +16,9 @@ Objective of one run (lower is better; all terms over the whole run)::
 with ITAE in m s^2, energy in N^2 s (N^2 m^2 s for moments) and TV the total variation of tau
 per second on a 10 ms grid.  A run that fails (pitch limit, divergence, envelope violation)
 costs ``penalty * (2 - t_fail / duration)``, more than any finite run and decreasing the
-longer the run survived.  The objective of a gain vector is the mean of J over the scenarios.
+longer the run survived; a candidate that the controller's own conditions refuse (Theorem 1
+for the FXTNTSMC, the ``setup`` gain checks of the others) costs ``3 * penalty``.  The objective
+of a gain vector is the mean of J over the scenarios.
 """
 from __future__ import annotations
 
@@ -30,7 +33,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from ..control.params import FTSMCParams, FXTNTSMCParams
+from ..control import get as get_controller
+from ..control.params import FXTNTSMCParams
 from ..control.theory import check_theorem1
 from ..scenario import load_scenario
 from ..simulation.api import prepare, run_prepared
@@ -103,7 +107,7 @@ class GainSpace:
 
     def defaults(self) -> dict[str, float]:
         """The package's default values of the tuned gains (the optimiser's first candidate)."""
-        model = FTSMCParams if self.kind == "ftsmc" else FXTNTSMCParams
+        model = get_controller(self.kind).params
         return {n: float(model.model_fields[n].default) for n in self.names}
 
 
@@ -111,11 +115,19 @@ class GainSpace:
 # surface weight beta <-> a1, surface exponent gamma <-> alpha.  The FXTNTSMC box keeps every
 # condition of Theorem 1 (kappa3 > 0.5; 0.5 < alpha, a2 alpha < 1 and a4 alpha > 1 with the
 # paper's a2 = 0.8, a4 = 2); the objective re-checks them with auvtrack.control.theory.
+# The baselines tune their three loop gains (docs/controllers.md) in boxes spanning two decades or
+# more around the defaults (the integral and adaptation gains down to 1e-4, near switched off); the PID's ki >= kd kp and the STA's Moreno-Osorio condition
+# (with the default L) cut parts of their boxes, which setup refuses and the objective penalises.
 SPACES: dict[str, GainSpace] = {
     "ftsmc": GainSpace("ftsmc", ("beta", "gamma", "k1", "k2"),
                        ((0.05, 20.0), (1.05, 1.95), (1e-3, 1.0), (0.05, 20.0)), (True, False, True, True)),
     "fxtntsmc": GainSpace("fxtntsmc", ("kappa1", "kappa3", "a1", "alpha"),
                           ((1e-3, 1.0), (0.51, 20.0), (0.05, 20.0), (0.55, 1.2)), (True, True, True, False)),
+    "pid": GainSpace("pid", ("kp", "ki", "kd"), ((0.1, 30.0), (1e-4, 30.0), (0.1, 30.0)), (True, True, True)),
+    "backstepping": GainSpace("backstepping", ("c1", "c2", "gamma"),
+                              ((0.05, 20.0), (0.05, 20.0), (1e-4, 50.0)), (True, True, True)),
+    "sta": GainSpace("sta", ("lam", "k1", "k2"), ((0.05, 20.0), (0.05, 20.0), (0.01, 20.0)), (True, True, True)),
+    "ppc": GainSpace("ppc", ("kp", "kd", "l"), ((0.5, 200.0), (0.5, 50.0), (0.05, 2.0)), (True, True, True)),
 }
 
 
@@ -206,12 +218,14 @@ PAPER_CASE = Case("sec4-100s")
 
 @dataclass(frozen=True)
 class Budget:
-    """Optimiser budget and run length, identical for both controllers.
+    """Optimiser budget and run length, identical for every controller.
 
     Attributes
     ----------
     popsize : int
-        Population multiplier of ``differential_evolution`` (population = popsize x 4 gains).
+        Population multiplier of ``differential_evolution`` for four gains: every controller
+        evaluates :attr:`population` = popsize x 4 candidates per generation (a three-gain
+        space uses the multiplier population / 3, see :meth:`de_popsize`).
     maxiter : int
         Generations after the initial population.
     seed : int
@@ -231,9 +245,22 @@ class Budget:
     n_train: int = 3
 
     @property
+    def population(self) -> int:
+        """Candidates per generation, the same for every controller: popsize x 4."""
+        return self.popsize * 4
+
+    @property
     def max_evaluations(self) -> int:
         """Gain vectors evaluated (``polish=False``): popsize x 4 x (maxiter + 1)."""
-        return self.popsize * 4 * (self.maxiter + 1)
+        return self.population * (self.maxiter + 1)
+
+    def de_popsize(self, n_gains: int) -> int:
+        """``differential_evolution``'s multiplier for ``n_gains`` gains: ceil(population / n_gains)."""
+        return -(-self.population // n_gains)
+
+    def evaluations(self, n_gains: int) -> int:
+        """Gain vectors evaluated for ``n_gains`` gains (= :attr:`max_evaluations` when n divides the population)."""
+        return self.de_popsize(n_gains) * n_gains * (self.maxiter + 1)
 
 
 FULL = Budget()
@@ -298,6 +325,11 @@ def run_cost(case: Case, kind: str, gains: dict[str, float], duration: float, dt
     -------
     tuple of (float, dict)
         J and a record with ``status``, ``failure`` (time, cause), ``J`` and the metrics used.
+
+    Raises
+    ------
+    ValueError
+        If the controller's ``setup`` refuses the gains (a gain condition).
     """
     res = run_prepared(prepare(load_scenario(case_scenario(case, kind, gains, duration, dt))))
     cost = objective.cost(res.status, res.failure, res.metrics, duration)
@@ -337,8 +369,8 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
 
     Parameters
     ----------
-    kind : {"ftsmc", "fxtntsmc"}
-        Controller.
+    kind : str
+        Controller, a key of :data:`SPACES`.
     budget : Budget, optional
         Population, generations, seed and run length (the same for every controller).
     objective : Objective, optional
@@ -365,8 +397,11 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     def mean_cost(gains: dict[str, float]) -> float:
         if kind == "fxtntsmc" and check_theorem1(FXTNTSMCParams(**gains)):
             return 3.0 * objective.penalty  # outside Theorem 1 (the box already excludes it)
-        return float(np.mean([run_cost(c, kind, gains, budget.duration, budget.dt, objective)[0]
-                              for c in cases]))
+        try:
+            return float(np.mean([run_cost(c, kind, gains, budget.duration, budget.dt, objective)[0]
+                                  for c in cases]))
+        except ValueError:  # the controller's setup refuses the gains (its gain conditions)
+            return 3.0 * objective.penalty
 
     def f(u: np.ndarray) -> float:
         return mean_cost(space.to_gains(u))
@@ -381,7 +416,8 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
                 progress(f"{kind}: generation {len(history)}/{budget.maxiter}, best J = {history[-1]:.4g}")
 
         res = differential_evolution(
-            f, space.search_bounds(), seed=budget.seed, popsize=budget.popsize, maxiter=budget.maxiter,
+            f, space.search_bounds(), seed=budget.seed, popsize=budget.de_popsize(len(space.names)),
+            maxiter=budget.maxiter,
             tol=0.0, atol=0.0, polish=False, init="latinhypercube", x0=space.to_search(start),
             updating="deferred", workers=pool.map, callback=callback)
     wall = time.perf_counter() - wall
@@ -459,7 +495,8 @@ def preset_toml(result: TuneResult, budget: Budget, objective: Objective) -> str
         "study = \"auvtrack study tuning\"",
         "optimiser = \"scipy.optimize.differential_evolution (polish = false, init = latinhypercube, x0 = package defaults)\"",
         f"seed = {budget.seed}",
-        f"popsize = {budget.popsize}",
+        f"popsize = {budget.de_popsize(len(space.names))}",
+        f"population = {budget.de_popsize(len(space.names)) * len(space.names)}",
         f"maxiter = {budget.maxiter}",
         f"evaluations = {result.nfev}",
         f"train_cases = {json.dumps([c.name for c in TRAIN_CASES[: budget.n_train]])}",
@@ -482,11 +519,11 @@ def _fmt(x: float) -> str:
 
 def _report(out: Path, results: dict[str, TuneResult], evals: dict, budget: Budget, objective: Objective,
             quick: bool, heldout: Sequence[Case]) -> Report:
-    rep = Report(out, "Fair tuning: FTSMC vs FXTNTSMC")
+    rep = Report(out, "Fair tuning of the controllers")
     if quick:
         rep.paragraph("**Quick mode** (CI smoke test): tiny budget, short runs; the numbers are not meaningful.")
-    rep.paragraph(f"Optimiser: SciPy differential_evolution, seed {budget.seed}, popsize {budget.popsize} "
-                  f"(x 4 gains), maxiter {budget.maxiter}, polish off, the package defaults as first candidate. "
+    rep.paragraph(f"Optimiser: SciPy differential_evolution, seed {budget.seed}, {budget.population} candidates "
+                  f"per generation, maxiter {budget.maxiter}, polish off, the package defaults as first candidate. "
                   f"Training: {', '.join(c.name for c in TRAIN_CASES[: budget.n_train])} "
                   f"({budget.duration:g} s, dt {budget.dt:g} s). Held-out: "
                   f"{', '.join(c.name for c in heldout)} ({budget.heldout_duration:g} s).")
@@ -517,15 +554,16 @@ def _report(out: Path, results: dict[str, TuneResult], evals: dict, budget: Budg
 
 
 def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
-    """Tune both controllers, evaluate on held-out scenarios, write presets and a report.
+    """Tune every controller of :data:`SPACES`, evaluate on held-out scenarios, write presets and a report.
 
     Parameters
     ----------
     out : pathlib.Path
-        Output folder (created): ``report.md``, ``report.html``, ``results.json``, ``ftsmc_tuned.toml`` and
-        ``fxtntsmc_tuned.toml`` (copy them to ``auvtrack/data/gains/`` to update the presets).
+        Output folder (created): ``report.md``, ``report.html``, ``results.json`` and one
+        ``<kind>_tuned.toml`` per controller (copy them to ``auvtrack/data/gains/`` to update the
+        presets).
     quick : bool, optional
-        CI smoke test: 16 evaluations of one 4 s scenario per controller.
+        CI smoke test: about 16 evaluations of one 4 s scenario per controller.
     progress : bool, optional
         Print one line per generation.
 
@@ -565,5 +603,5 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     return _report(out, results, evals, budget, objective, quick, heldout).write()
 
 
-STUDY = StudySpec("tuning", run, "fair tuning of FTSMC and FXTNTSMC: same optimiser, budget, objective; "
+STUDY = StudySpec("tuning", run, "fair tuning of every controller: same optimiser, budget, objective; "
                   "held-out evaluation; writes gain presets")

@@ -1,0 +1,99 @@
+"""Backstepping baseline: Lyapunov backstepping on (e, e_dot) with an optional adaptive bias.
+
+Per axis (docs/controllers.md, eq. B1-B4), with the lumped disturbance chi entering as
+e_ddot = a + chi (eq. 15):
+
+    z1 = e,   alpha1 = -c1 z1,   z2 = e_dot - alpha1 = e_dot + c1 e             (B1)
+    a  = -c1 e_dot - z1 - c2 z2 - b_hat                                        (B2, m/s^2)
+    b_hat_dot = gamma z2 - sigma b_hat   (adaptive = true; else b_hat = 0)     (B3)
+
+so that z1_dot = z2 - c1 z1 and z2_dot = -z1 - c2 z2 + (chi - b_hat).  With
+V = z1^2/2 + z2^2/2 + (chi - b_hat)^2 / (2 gamma) and a constant chi,
+
+    V_dot = -c1 z1^2 - c2 z2^2 + sigma (chi - b_hat) b_hat / gamma             (B4)
+
+(sigma = 0: V_dot <= 0 and z -> 0; sigma > 0, the leakage, trades the exact rejection of a
+constant bias for a bounded estimate).  On the disturbance-free nominal plant (chi = 0) the
+triple (z1, z2, b_hat) obeys a linear system exactly; that identity is what the tests check.
+
+Sources: integrator backstepping and its adaptive version with a tuning-function-free update,
+Krstic, Kanellakopoulos & Kokotovic (1995), *Nonlinear and Adaptive Control Design*, Wiley,
+ch. 2 (integrator backstepping) and ch. 3-4 (adaptive backstepping); the sigma-modification
+leakage, Ioannou & Sun (1996), *Robust Adaptive Control*, ch. 8.
+
+Packed ``cp`` = [c1, c2, gamma (0 when not adaptive), sigma]; internal state xc = b_hat (3,
+m/s^2); logged aux: z2_x, z2_y, z2_z, b_hat_x, b_hat_y, b_hat_z.
+"""
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import Field
+
+from .._jit import njit, njit_noalloc
+from .gain_checks import require
+from .registry import CompiledController, ControllerParams
+from .tracking import error_state_forces, input_for_accel_forces
+
+NAME = "backstepping"
+AUX_NAMES = ("z2_x", "z2_y", "z2_z", "b_hat_x", "b_hat_y", "b_hat_z")
+C1, C2, GAMMA, SIGMA = 0, 1, 2, 3
+
+
+class Params(ControllerParams):
+    """Backstepping on (e, e_dot) with an optional adaptive estimate of the lumped disturbance (eq. B1-B4)."""
+
+    kind: Literal["backstepping"] = "backstepping"
+    c1: float = Field(1.0, gt=0, description="first-step gain, 1/s")
+    c2: float = Field(2.0, gt=0, description="second-step gain, 1/s")
+    adaptive: bool = Field(True, description="estimate a bias b_hat of the lumped disturbance (eq. B3)")
+    gamma: float = Field(2.0, gt=0, description="adaptation gain, 1/s^2 (used when adaptive)")
+    sigma: float = Field(0.0, ge=0, description="leakage of b_hat (sigma-modification), 1/s")
+
+
+@njit
+def axis(e, ed, bh, c1, c2, gam, sig):
+    """(z2 (m/s), a (m/s^2), b_hat_dot (m/s^3)) of one axis, eq. (B1)-(B3)."""
+    z2 = ed + c1 * e
+    return z2, -c1 * ed - e - c2 * z2 - bh, gam * z2 - sig * bh
+
+
+@njit_noalloc(inline="always")
+def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+    """Compiled backstepping law, eq. (B1)-(B3) (tau in N, N m); returns 0."""
+    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
+    c1, c2, gam, sig = cp[C1], cp[C2], cp[GAMMA], cp[SIGMA]
+    z0, a0, d0 = axis(e[0], ed[0], xc[0], c1, c2, gam, sig)
+    z1, a1, d1 = axis(e[1], ed[1], xc[1], c1, c2, gam, sig)
+    z2, a2, d2 = axis(e[2], ed[2], xc[2], c1, c2, gam, sig)
+    dxc[0], dxc[1], dxc[2] = d0, d1, d2
+    aux[0], aux[1], aux[2], aux[3], aux[4], aux[5] = z0, z1, z2, xc[0], xc[1], xc[2]
+    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, (a0, a1, a2), gf)
+    return 0
+
+
+def check(p: Params) -> None:
+    """Conditions of eq. (B4): c1, c2 > 0 (model ranges), and no leakage without adaptation.
+
+    Parameters
+    ----------
+    p : Params
+        The gains.
+
+    Raises
+    ------
+    ValueError
+        ``controller.sigma: ...`` when a leakage is given with ``adaptive = false``.
+    """
+    require(p.adaptive or p.sigma == 0.0, "sigma", "a leakage needs adaptive = true (b_hat is fixed at 0 otherwise)",
+            p.sigma)
+
+
+def setup(scenario, ctx) -> CompiledController:
+    """Pack the gains; b_hat(0) = 0 (adaptation off: gamma = sigma = 0 and b_hat stays 0)."""
+    p: Params = scenario.controller
+    check(p)
+    gam = p.gamma if p.adaptive else 0.0
+    cp = np.array([p.c1, p.c2, gam, p.sigma], dtype=np.float64)
+    return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES)

@@ -1,0 +1,113 @@
+"""PID baseline: computed torque through the nominal model with a PID outer loop on e.
+
+Per axis i of the virtual-point error e (docs/controllers.md, eq. P1-P3):
+
+    a_i     = -kp e_i - kd e_dot_i - ki I_i                          (P1, m/s^2)
+    I_dot_i = e_i - (kaw / ki) da_i                                  (P2, back-calculation)
+    tau     = input_for_accel(a)                                     (eq. 4 inverted, tracking.py)
+
+The input map makes e_ddot = a on the nominal model, and e_ddot contains -eta_d_ddot (eq. 15):
+the reference acceleration is fed forward.  On the disturbance-free nominal plant the error
+obeys the linear law e''' + kd e'' + kp e' + ki e = 0 (P3), Hurwitz iff kp, kd > 0, 0 <= ki <
+kd kp (Routh-Hurwitz; checked in :func:`setup`).  da is the e_ddot that the actuator
+saturation |tau_j| <= tau_max_j removes on the nominal model, da = J3 M_bar^-1 (sat(tau) - tau)
+(u, q, r rows); feeding it back stops the integrator from winding up (0 without saturation).
+
+Sources: computed-torque (inverse-dynamics) control with a PD/PID outer loop and reference
+acceleration feed-forward, Spong, Hutchinson & Vidyasagar (2006), *Robot Modeling and Control*,
+ch. 8 (inverse dynamics); back-calculation anti-windup with tracking gain 1/T_t, Astrom &
+Hagglund (2006), *Advanced PID Control*, ch. 3 (integrator windup).
+
+Packed ``cp`` = [kp, ki, kd, kaw / ki (0 if ki = 0), tau_max (3)]; internal state xc = I (3,
+m s); logged aux: I_x, I_y, I_z.
+"""
+from __future__ import annotations
+
+import numpy as np
+from pydantic import Field
+from typing import Literal
+
+from .._jit import njit, njit_noalloc
+from ..plant.kinematics import j3
+from ..plant.params import ELL, M0
+from .gain_checks import require
+from .registry import CompiledController, ControllerParams
+from .tracking import error_state_forces, input_for_accel_forces, mat_vec
+
+NAME = "pid"
+AUX_NAMES = ("I_x", "I_y", "I_z")
+KP, KI, KD, KAW_KI, TAU_MAX = 0, 1, 2, 3, 4
+
+
+class Params(ControllerParams):
+    """Computed-torque PID on the virtual-point error (docs/controllers.md, eq. P1-P3).
+
+    The defaults place the three poles of eq. (P3) at s = -1 rad/s: (s + 1)^3.
+    """
+
+    kind: Literal["pid"] = "pid"
+    kp: float = Field(3.0, gt=0, description="proportional gain, 1/s^2")
+    ki: float = Field(1.0, ge=0, description="integral gain, 1/s^3 (0: PD); ki < kd kp")
+    kd: float = Field(3.0, gt=0, description="derivative gain, 1/s")
+    kaw: float = Field(1.0, ge=0, description="back-calculation (anti-windup) gain 1/T_t, 1/s")
+
+
+@njit
+def _clip(x, m):
+    return -m if x < -m else (m if x > m else x)
+
+
+@njit_noalloc(inline="always")
+def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+    """Compiled PID law, eq. (P1)-(P2) (tau in N, N m); returns 0 (no failure modes of its own)."""
+    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
+    kp, ki, kd = cp[KP], cp[KI], cp[KD]
+    a = (-kp * e[0] - kd * ed[0] - ki * xc[0],
+         -kp * e[1] - kd * ed[1] - ki * xc[1],
+         -kp * e[2] - kd * ed[2] - ki * xc[2])
+    t0, t1, t2 = input_for_accel_forces(att, vp, f, a, gf)
+    tau[0], tau[1], tau[2] = t0, t1, t2
+    # e_ddot removed by the saturation on the nominal model: J3 M_bar^-1 (sat(tau) - tau)
+    dv = ((_clip(t0, cp[TAU_MAX]) - t0) / vp[M0],
+          (_clip(t1, cp[TAU_MAX + 1]) - t1) / vp[M0 + 3],
+          (_clip(t2, cp[TAU_MAX + 2]) - t2) / vp[M0 + 4])
+    da = mat_vec(j3(att, vp[ELL]), dv)
+    g = cp[KAW_KI]
+    on = 1.0 if ki > 0.0 else 0.0  # a PD keeps its (unused) integrator at rest
+    dxc[0] = on * (e[0] - g * da[0])
+    dxc[1] = on * (e[1] - g * da[1])
+    dxc[2] = on * (e[2] - g * da[2])
+    aux[0], aux[1], aux[2] = xc[0], xc[1], xc[2]
+    return 0
+
+
+def check(p: Params) -> None:
+    """Routh-Hurwitz condition of eq. (P3): s^3 + kd s^2 + kp s + ki is Hurwitz iff ki < kd kp.
+
+    Parameters
+    ----------
+    p : Params
+        The gains (their signs are already checked by the model).
+
+    Raises
+    ------
+    ValueError
+        ``controller.ki: ...`` when ki >= kd kp.
+    """
+    require(p.ki < p.kd * p.kp, "ki",
+            f"must be < kd * kp = {p.kd * p.kp:.6g} (Routh-Hurwitz: e''' + kd e'' + kp e' + ki e = 0 stable)",
+            p.ki)
+
+
+def setup(scenario, ctx) -> CompiledController:
+    """Check eq. (P3)'s stability condition and pack gains and actuator limits; I(0) = 0."""
+    p: Params = scenario.controller
+    check(p)
+    tau_max = np.asarray(ctx.actuator.tau_max, dtype=np.float64)
+    cp = np.array([p.kp, p.ki, p.kd, p.kaw / p.ki if p.ki > 0 else 0.0, *tau_max], dtype=np.float64)
+    notes = ()
+    if p.ki > 0 and p.kaw == 0 and bool(np.any(np.isfinite(tau_max))):
+        notes = ("pid: controller.kaw = 0 with a finite actuator.tau_max: the integrator may wind up",)
+    poles = np.roots([1.0, p.kd, p.kp, p.ki] if p.ki > 0 else [1.0, p.kd, p.kp])  # of eq. (P3)
+    return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES, notes=notes,
+                              resolved={"error_poles": [[float(z.real), float(z.imag)] for z in poles]})

@@ -1,0 +1,148 @@
+"""PPC baseline: classical prescribed-performance control with a rigid exponential envelope.
+
+The scheme the paper improves on (its Sec. 1: rigid bounds "may induce system instability under
+large disturbances").  Per axis (docs/controllers.md, eq. R1-R4):
+
+    rho(t)  = (rho0 - rho_inf) exp(-l t) + rho_inf                        (R1, m)
+    xi = e / rho,  eps = atanh(xi) = 1/2 ln((1 + xi) / (1 - xi))          (R2)
+    eps_dot = Omega e_dot - U e,  Omega = rho / D,  U = rho_dot / D,  D = rho^2 - e^2
+    eps_ddot = Omega_dot e_dot + Omega e_ddot - U_dot e - U e_dot         (R3)
+    e_ddot*  = (nu - Omega_dot e_dot + U_dot e + U e_dot) / Omega,
+    nu       = -kp eps - kd eps_dot                                       (R4)
+
+(R1) is the exponential performance function and (R2) the error transformation of
+Bechlioulis & Rovithakis (2008) with a symmetric envelope (their M = 1, S = tanh): e stays
+inside (-rho, rho) for as long as eps stays bounded.  The envelope is rigid: rho is a fixed
+function of time, with no widening and no adjustment; a start on or outside it is refused by
+:func:`setup`, and an error that reaches it stops the run (status 1).  As for every baseline
+here, the transformed error is controlled through the nominal model (the input map of
+tracking.py): on the disturbance-free nominal plant eps obeys eps_ddot = -kp eps - kd eps_dot
+exactly, and on the true plant eps_ddot = nu + Omega chi, with Omega >= 1 / rho growing as the
+envelope narrows -- the mechanism by which a large disturbance breaks a rigid envelope.
+B&R's adaptive approximation of the unknown dynamics is not used (the baselines share the
+nominal model; none of them estimates chi except ``backstepping``'s optional bias).
+
+Source: Bechlioulis, C. P. & Rovithakis, G. A. (2008), Robust adaptive control of feedback
+linearizable MIMO nonlinear systems with prescribed performance, IEEE Trans. Autom. Control
+53(9), 2090-2099 (performance function, error transformation).
+
+Packed ``cp`` = [kp, kd, l, rho0 (3), rho_inf (3)]; no internal state; logged aux: rho_x,
+rho_y, rho_z, eps_x, eps_y, eps_z.
+"""
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field
+
+from .._jit import njit, njit_noalloc
+from .gain_checks import fmt, require
+from .registry import CompiledController, ControllerParams
+from .tracking import error_state_forces, input_for_accel_forces
+
+NAME = "ppc"
+AUX_NAMES = ("rho_x", "rho_y", "rho_z", "eps_x", "eps_y", "eps_z")
+STATUS = {1: "envelope violated: |e_i| >= rho_i (the error transformation is undefined)"}
+KP, KD, DECAY, RHO0, RHOINF = 0, 1, 2, 3, 6
+AXES = ("x", "y", "z")
+Pos = Annotated[float, Field(gt=0)]
+
+
+class Params(ControllerParams):
+    """Prescribed-performance control with the rigid envelope (R1) of Bechlioulis & Rovithakis (2008).
+
+    rho_inf is the paper's Section 4 value; rho0 is its 5 m in x and larger in y and z so that
+    every start of the tuning study lies strictly inside (the Section 4 start has |e_y(0)| =
+    0.5 m, on the paper's rho_{2,0} = 0.5 m, and a rigid envelope cannot start there).
+    """
+
+    kind: Literal["ppc"] = "ppc"
+    kp: float = Field(16.0, gt=0, description="gain on eps, 1/s^2")
+    kd: float = Field(8.0, gt=0, description="gain on eps_dot, 1/s")
+    l: float = Field(0.3, gt=0, description="envelope decay rate, 1/s")
+    rho0: tuple[Pos, Pos, Pos] = Field((5.0, 1.5, 1.0), description="rho(0) per axis, m")
+    rho_inf: tuple[Pos, Pos, Pos] = Field((0.005, 0.005, 0.005), description="rho(inf) per axis, m")
+
+
+@njit
+def envelope_x(x, r0, rinf, l):
+    """(rho, rho_dot, rho_ddot) of eq. (R1) (m, m/s, m/s^2) given x = exp(-l t)."""
+    d = (r0 - rinf) * x
+    return d + rinf, -l * d, l * l * d
+
+
+@njit
+def envelope(t, r0, rinf, l):
+    """(rho, rho_dot, rho_ddot) of eq. (R1) at time t (s)."""
+    return envelope_x(math.exp(-l * t), r0, rinf, l)
+
+
+@njit
+def axis(e, ed, rho, rhod, rhodd, kp, kd):
+    """(status, eps, e_ddot*) of one axis, eq. (R2)-(R4); status 1 when |e| >= rho."""
+    xi = e / rho
+    if not abs(xi) < 1.0:
+        return 1, 0.0, 0.0
+    D = rho * rho - e * e
+    Om, U = rho / D, rhod / D
+    eps = math.atanh(xi)
+    epsd = Om * ed - U * e
+    Dd = 2.0 * rho * rhod - 2.0 * e * ed
+    Omd = rhod / D - rho * Dd / (D * D)
+    Ud = rhodd / D - rhod * Dd / (D * D)
+    nu = -kp * eps - kd * epsd
+    return 0, eps, (nu - Omd * ed + Ud * e + U * ed) / Om
+
+
+@njit_noalloc(inline="always")
+def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+    """Compiled PPC law, eq. (R1)-(R4) (tau in N, N m); status 1 if an error reaches its envelope."""
+    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
+    kp, kd, l = cp[KP], cp[KD], cp[DECAY]
+    x = math.exp(-l * t)  # shared by the three axes
+    r0 = envelope_x(x, cp[RHO0], cp[RHOINF], l)
+    r1 = envelope_x(x, cp[RHO0 + 1], cp[RHOINF + 1], l)
+    r2 = envelope_x(x, cp[RHO0 + 2], cp[RHOINF + 2], l)
+    aux[0], aux[1], aux[2] = r0[0], r1[0], r2[0]
+    st0, eps0, a0 = axis(e[0], ed[0], r0[0], r0[1], r0[2], kp, kd)
+    st1, eps1, a1 = axis(e[1], ed[1], r1[0], r1[1], r1[2], kp, kd)
+    st2, eps2, a2 = axis(e[2], ed[2], r2[0], r2[1], r2[2], kp, kd)
+    if st0 + st1 + st2 != 0:
+        return 1
+    aux[3], aux[4], aux[5] = eps0, eps1, eps2
+    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, (a0, a1, a2), gf)
+    return 0
+
+
+def check(p: Params, e0) -> None:
+    """Envelope conditions: rho_inf <= rho0 per axis, and the start strictly inside, |e_i(0)| < rho0_i.
+
+    Parameters
+    ----------
+    p : Params
+        The gains and envelope.
+    e0 : sequence of 3 float
+        Initial virtual-point error (m).
+
+    Raises
+    ------
+    ValueError
+        ``controller.rho_inf: ...`` or ``controller.rho0: ...`` naming the axis.
+    """
+    for i, a in enumerate(AXES):
+        require(p.rho_inf[i] <= p.rho0[i], "rho_inf", f"must be <= rho0 = {fmt(list(p.rho0))} on axis {a} "
+                "(a shrinking envelope)", list(p.rho_inf))
+        require(abs(e0[i]) < p.rho0[i], "rho0",
+                f"the start lies on or outside the rigid envelope on axis {a} (|e_{a}(0)| = {abs(e0[i]):.6g} m "
+                f">= rho0_{a}); enlarge rho0 (a rigid PPC cannot widen)", list(p.rho0))
+
+
+def setup(scenario, ctx) -> CompiledController:
+    """Check the envelope against the start ``ctx.e0`` and pack gains and envelope."""
+    p: Params = scenario.controller
+    check(p, ctx.e0)
+    cp = np.array([p.kp, p.kd, p.l, *p.rho0, *p.rho_inf], dtype=np.float64)
+    xi0 = [float(ctx.e0[i] / p.rho0[i]) for i in range(3)]
+    return CompiledController(cp=cp, xc0=np.zeros(0), aux_names=AUX_NAMES, resolved={"xi0": xi0})
