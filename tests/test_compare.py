@@ -243,3 +243,18 @@ def test_the_sizing_numbers_of_the_docs_are_the_suite_s():
     h = load_suite().failure_halfwidths()
     text = (Path(__file__).resolve().parents[1] / "docs" / "benchmark.md").read_text()
     assert f"{h['tier']:.4f}" in text and f"{h['zero_failures']:.3f}" in text and f"±{h['cell']:.3f}" in text
+
+
+def test_a_plugin_enters_the_leaderboard_with_one_flag(tiny, tmp_path):
+    plugin = Path(__file__).resolve().parents[1] / "examples" / "plugin_controller.py"
+    out = tmp_path / "p"
+    assert main(["compare", "--suite", str(tiny), "--quick", "--controllers", "ftsmc", "--plugin", str(plugin),
+                 "--out", str(out), "--quiet"]) == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert sorted(r["controller"] for r in doc["leaderboard"]) == ["ftsmc", "plugin_controller"]
+    entry = next(c for c in doc["controllers"] if c["label"] == "plugin_controller")
+    assert entry["table"] == {"kind": "plugin", "module": str(plugin)} and len(entry["digest"]) == 64
+    runs = pd.read_parquet(out / "runs.parquet")
+    mine = runs[runs["controller"] == "plugin_controller"]
+    assert len(mine) == 2 * 2 * 2 and (mine["cause"] != "setup").all()
+    assert "plugin_controller" in (out / "report.md").read_text()
