@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from auvtrack._atomic import atomic_write, open_exclusive
 from auvtrack.cli import EXIT_BAD_INPUT, EXIT_SIM_FAILED, main
-from auvtrack.control.registry import CONTROLLERS
+from auvtrack.control import BUILTIN_NAMES
 from auvtrack.simulation.result import RUN_FILES, Result, verify_run_folder
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -197,7 +197,7 @@ VARIANTS = {
     "currents": ["disturbance.1.kind=current", "disturbance.1.sample_dt=0.01", "disturbance.2.kind=current",
                  "disturbance.2.sigma=[0.2, 0.1, 0.05]", "disturbance.2.tau=5"],
 }
-CASES = [(kind, v) for kind in sorted(CONTROLLERS) for v in VARIANTS]
+CASES = [(kind, v) for kind in sorted(BUILTIN_NAMES) for v in VARIANTS]
 
 
 @pytest.mark.parametrize("kind, variant", CASES, ids=[f"{k}-{v}" for k, v in CASES])

@@ -10,7 +10,7 @@ from pathlib import Path
 from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
-from auvtrack.control.registry import CONTROLLERS
+from auvtrack.control import BUILTIN_NAMES
 from auvtrack.scenario import ScenarioError, load_scenario
 from auvtrack.simulation.api import prepare
 from doc_ranges import documented_ranges
@@ -89,7 +89,7 @@ def assert_error_names(data, path: str) -> None:
 # --- forbidden ranges, read from the documented table (docs/scenarios.md), never from the schema -
 
 # every registered controller's rows of the [controller] table are checked on the paper scenario
-BASES = {"": BASE, **{kind: load_scenario(PAPER, [f"controller.kind={kind}"]).to_dict() for kind in CONTROLLERS}}
+BASES = {"": BASE, **{kind: load_scenario(PAPER, [f"controller.kind={kind}"]).to_dict() for kind in BUILTIN_NAMES}}
 DOCUMENTED = [(rng, BASES.get(kind)) for kind, rngs in documented_ranges(BASE).items() for rng in rngs
               if kind in BASES]
 

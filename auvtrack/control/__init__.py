@@ -16,9 +16,11 @@ BUILTIN = (
     ppc,
     open_loop,
 )
+BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
+"""Kinds of the built-in controllers (``plugin``, the loader of outside controllers, is not one)."""
 for _module in BUILTIN:
     register(ControllerSpec.from_module(_module))
 register(ControllerSpec.from_module(plugin))
 
-__all__ = ["BUILTIN", "CONTROLLERS", "CompiledController", "ControllerParams", "ControllerSpec", "get",
+__all__ = ["BUILTIN", "BUILTIN_NAMES", "CONTROLLERS", "CompiledController", "ControllerParams", "ControllerSpec", "get",
            "register", "FTSMCParams", "FXTNTSMCParams", "OpenLoopParams"]

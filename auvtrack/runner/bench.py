@@ -38,9 +38,9 @@ def machine() -> dict:
 
 def builtin_controllers() -> tuple[str, ...]:
     """Kinds of the built-in controllers (``auvtrack.control.BUILTIN``; the plug-in loader is not one)."""
-    from ..control import BUILTIN
+    from ..control import BUILTIN_NAMES
 
-    return tuple(m.NAME for m in BUILTIN)
+    return BUILTIN_NAMES
 
 
 def plugin_copy(kind: str, folder: Path) -> Path:
