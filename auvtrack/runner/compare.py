@@ -123,7 +123,7 @@ def _prepare(spec: RunSpec):
         return " ".join(str(exc).split()) or type(exc).__name__
 
 
-def run_chunk(specs: Sequence[RunSpec], *, backend: str = "serial", workers: int | None = None):
+def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1):
     """Prepare and run ``specs`` (metrics only) and return one row per run as an Arrow table.
 
     A run whose set-up is refused (a controller rejecting its gains or the start, a plug-in that
@@ -134,8 +134,9 @@ def run_chunk(specs: Sequence[RunSpec], *, backend: str = "serial", workers: int
     ----------
     specs : sequence of RunSpec
         The chunk's runs.
-    backend, workers
-        As :func:`auvtrack.runner.batch.run_batch`.
+    workers : int or None, optional
+        Threads of :func:`auvtrack.runner.batch.run_batch` (None: every core; 1 on a Dask
+        worker, which is single-threaded); its default back end is used.
 
     Returns
     -------
@@ -152,7 +153,7 @@ def run_chunk(specs: Sequence[RunSpec], *, backend: str = "serial", workers: int
     schema = _schema()
     prepared = [_prepare(s) for s in specs]
     runnable = [p for p in prepared if not isinstance(p, str)]
-    summaries = iter(run_batch(runnable, backend=backend, workers=workers))
+    summaries = iter(run_batch(runnable, workers=workers))
     cols: dict[str, list] = {f.name: [] for f in schema}
     for spec, prep in zip(specs, prepared):
         row: dict[str, Any] = {"run": spec.run, "controller": spec.controller, "task": spec.task, "tier": spec.tier,
@@ -331,7 +332,7 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
             if local:
                 t0 = time.perf_counter()
                 for c in todo:
-                    table = run_chunk(chunks[c], backend="threads", workers=workers)
+                    table = run_chunk(chunks[c], workers=workers)
                     _write_atomic_table(table, chunk_path(out, c))
                     written += 1
                     bar.update(table.num_rows)
