@@ -215,7 +215,10 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 @click.option("--out", "bench_out", type=click.Path(file_okay=False), default=None,
               help="Folder for the --all results (default: a new folder under ~/.local/share/auvtrack/bench, "
                    "or $XDG_DATA_HOME; never the source tree unless asked, e.g. --out benchmarks).")
-def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None) -> None:
+@click.option("--plant", type=click.Choice(["5dof", "6dof"]), default="5dof", show_default=True,
+              help="Plant model: 5dof (Section 4) or 6dof (each REMUS 100 truth preset, a 1 m/s line).")
+def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None,
+          plant: str = "5dof") -> None:
     """Time the compiled closed loop: µs per RK4 step, one JSON line per controller (every built-in by default).
 
     --all runs the full suite (batch runs/s, Dask sweep throughput) and writes results.json and
@@ -234,8 +237,12 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
         click.echo(json.dumps(doc, indent=2))
         click.echo(f"written: {folder / 'results.json'}, {folder / 'results.md'}")
         return
-    from .runner.bench import bench_singles, builtin_controllers
+    from .runner.bench import bench_plant, bench_singles, builtin_controllers
 
+    if plant != "5dof":  # issue 11: the 6-DOF truths, one line per (controller, preset)
+        for row in bench_plant(controllers or ("ftsmc", "fxtntsmc"), plant, repeat=repeat, duration=duration):
+            click.echo(json.dumps(row))
+        return
     for row in bench_singles(controllers or builtin_controllers(), repeat=repeat, duration=duration):
         click.echo(json.dumps(row))
 

@@ -58,3 +58,44 @@ def test_every_shipped_preset_is_available():
     assert set(SHIPPED) <= set(available())
     for name in SHIPPED:
         get_preset(name)
+
+
+# --- the reduction of remus100_prestero at a speed U0 (issue 13, point 6) -------------------------
+
+def test_reduction_is_computed_from_the_6dof_data_at_u0():
+    from auvtrack.plant.sixdof.presets import load_preset6
+    from auvtrack.plant.reduction import reduce_prestero
+    v = load_preset6("remus100_prestero").values
+    for u0 in (0.3, 0.41, 1.5, 2.0):
+        red = reduce_prestero(u0)
+        assert red["d"] == pytest.approx((-2 * v["drag.X_uu"] * u0, -v["combined.Y_uv"] * u0,
+                                          -v["combined.Z_uw"] * u0, -v["combined.M_uq"] * u0,
+                                          -v["combined.N_ur"] * u0), rel=1e-15)
+        assert get_preset("remus100", u0=u0).d == red["d"]
+    assert get_preset("remus100").u0 == U0  # without a scenario: P01's trial speed
+
+
+def test_scenario_linearises_remus100_at_the_reference_speed():
+    from auvtrack.plant.reduction import reference_speed
+    from auvtrack.reference import build_reference
+    sc = load_scenario(ROOT / "scenarios" / "remus100.toml")
+    helix = build_reference(sc.reference)
+    u_ref = reference_speed(helix, sc.sim.duration)
+    assert sc.vehicle.u0 == pytest.approx(u_ref, rel=1e-12)
+    assert u_ref == pytest.approx(0.4123, abs=1e-4)  # Section 4 helix: |eta_d_dot| = sqrt(0.4^2 + 0.1^2)
+    assert sc.vehicle.d == get_preset("remus100", u0=sc.vehicle.u0).d
+    assert sc.vehicle.resolve()["u0"] == sc.vehicle.u0
+    assert load_scenario(sc.to_dict()) == sc
+    sc2 = load_scenario(ROOT / "scenarios" / "remus100.toml", ["vehicle.u0=1.5"])
+    assert sc2.vehicle.d == pytest.approx(get_preset("remus100").d)
+
+
+def test_u0_bad_input():
+    from auvtrack.scenario import ScenarioError
+    with pytest.raises(ScenarioError, match=r"vehicle.u0: only a reduced preset"):
+        load_scenario({"vehicle": {"preset": "paper", "u0": 1.0}})
+    with pytest.raises(ScenarioError, match=r"vehicle.u0"):
+        load_scenario({"vehicle": {"preset": "remus100", "u0": 9.0}})
+    with pytest.raises(ScenarioError, match=r"vehicle.u0: the reference's mean speed"):
+        load_scenario({"vehicle": {"preset": "remus100"},
+                       "reference": {"kind": "line", "velocity": [0.0, 0.0, 0.0]}})

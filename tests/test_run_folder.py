@@ -204,6 +204,8 @@ CASES = [(kind, v) for kind in sorted(BUILTIN_NAMES) for v in VARIANTS]
 def test_scenario_toml_reproduces_the_trajectory_byte_for_byte(tmp_path, kind, variant):
     first, second = tmp_path / "first", tmp_path / "second"
     args = ["--set", f"controller.kind={kind}", "--set", "sim.duration=0.5", "--set", "seed=7"]
+    if kind == "open_loop_actuators":  # drives a 6-DOF plant's fins and propeller (issue 11)
+        args += ["--set", "plant.model=6dof"]
     for ov in VARIANTS[variant]:
         args += ["--set", ov]
     code, err = _quiet_main(["run", str(PAPER), "--out", str(first), *args])

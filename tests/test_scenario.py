@@ -319,8 +319,10 @@ def test_controller_union_covers_registry():
     kinds = {m.model_fields["kind"].default for m in CONTROLLER_MODELS}
     assert kinds == set(CONTROLLERS)
     example = Path(__file__).resolve().parents[1] / "examples" / "plugin_controller.py"
+    needs_6dof = {"open_loop_actuators"}  # commands fins and propeller (issue 11)
     for kind in kinds:  # a plug-in needs its module
         extra = [f"controller.module=\"{example}\""] if kind == "plugin" else []
+        extra += ["plant.model=6dof"] if kind in needs_6dof else []
         assert load_scenario({}, [f"controller.kind={kind}", *extra]).controller.kind == kind
     with pytest.raises(ScenarioError, match="controller.module: required key is missing"):
         load_scenario({}, ["controller.kind=plugin"])

@@ -10,7 +10,7 @@ from pathlib import Path
 from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
-from auvtrack.control import BUILTIN_NAMES
+from auvtrack.control import CONTROLLERS
 from auvtrack.scenario import ScenarioError, load_scenario
 from auvtrack.simulation.api import prepare
 from doc_ranges import documented_ranges
@@ -89,7 +89,10 @@ def assert_error_names(data, path: str) -> None:
 # --- forbidden ranges, read from the documented table (docs/scenarios.md), never from the schema -
 
 # every registered controller's rows of the [controller] table are checked on the paper scenario
-BASES = {"": BASE, **{kind: load_scenario(PAPER, [f"controller.kind={kind}"]).to_dict() for kind in BUILTIN_NAMES}}
+_NEEDS = {"open_loop_actuators": ["plant.model=6dof"],  # commands fins and propeller (issue 11)
+          "plugin": [f'controller.module="{Path(__file__).resolve().parents[1] / "examples" / "plugin_controller.py"}"']}
+BASES = {"": BASE, **{kind: load_scenario(PAPER, [f"controller.kind={kind}", *_NEEDS.get(kind, [])]).to_dict()
+                      for kind in CONTROLLERS}}
 DOCUMENTED = [(rng, BASES.get(kind)) for kind, rngs in documented_ranges(BASE).items() for rng in rngs
               if kind in BASES]
 

@@ -3,7 +3,7 @@
 Registering a built-in controller is one line: its module in :data:`BUILTIN`.  ``plugin`` is
 registered after them: it is the loader of controllers from outside the package (kind ``"plugin"``).
 """
-from . import backstepping, ftsmc, fxtntsmc, open_loop, pid, plugin, ppc, sta
+from . import backstepping, ftsmc, fxtntsmc, open_loop, open_loop_actuators, pid, plugin, ppc, sta
 from .params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
 from .registry import CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, get, register
 
@@ -15,6 +15,7 @@ BUILTIN = (
     sta,
     ppc,
     open_loop,
+    open_loop_actuators,
 )
 BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
 """Kinds of the built-in controllers (``plugin``, the loader of outside controllers, is not one)."""

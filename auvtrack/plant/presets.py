@@ -6,7 +6,9 @@ from.  Registering a preset means adding its file: :func:`available` lists the f
 
 * ``paper`` -- the torpedo AUV of the paper's Section 4 (ERRATA 5; partly assumed);
 * ``remus100`` -- the REMUS 100 (Prestero 2001) reduced to the diagonal 5-DOF form, damping
-  linearised at 1.5 m/s (reduction in ``docs/vehicles.md``).
+  linearised at a speed U0: a *reduced* preset, computed by :mod:`auvtrack.plant.reduction`
+  from the 6-DOF ``remus100_prestero`` data (``get_preset("remus100", u0=...)``; reduction in
+  ``docs/vehicles.md``).
 
 :data:`SHIPPED` names them; a test checks that each one is present and valid.  Use :func:`get_preset` to read one and :func:`pack_vehicle` to build the packed ``vp``
 array of :mod:`auvtrack.plant.params`.
@@ -45,6 +47,8 @@ class VehiclePreset:
         Virtual-point offset ell of eq. (2) (m).
     sources : dict
         Per field: ``{"unit": ..., "source": ...}``.
+    u0 : float or None
+        Linearisation speed (m/s) of a reduced preset; None for a preset stored as numbers.
     """
 
     name: str
@@ -54,6 +58,7 @@ class VehiclePreset:
     wgml: float
     l: float
     sources: dict
+    u0: float | None = None
 
 
 def available() -> list[str]:
@@ -74,13 +79,21 @@ def _parsed(name: str) -> dict:
     return tomllib.loads((resources.files("auvtrack") / "data" / "vehicles" / f"{name}.toml").read_text())
 
 
-def get_preset(name: str) -> VehiclePreset:
+def is_reduced(name: str) -> bool:
+    """True for a preset computed from a 6-DOF model at a linearisation speed (e.g. ``remus100``)."""
+    return name in available() and "reduction_of" in _parsed(name)
+
+
+def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
     """Load a vehicle preset from ``auvtrack/data/vehicles``.
 
     Parameters
     ----------
     name : str
         Preset name, e.g. ``"paper"``.
+    u0 : float, optional
+        Linearisation speed (m/s) of a reduced preset (default: the file's ``u0``); refused for
+        a preset stored as numbers.
 
     Returns
     -------
@@ -91,10 +104,23 @@ def get_preset(name: str) -> VehiclePreset:
     ------
     KeyError
         If there is no such preset (the message names the available ones).
+    ValueError
+        ``u0`` given for a preset that is not reduced, or out of range.
     """
     if name not in available():
         raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available()}")
     raw = copy.deepcopy(_parsed(name))  # callers own what they get
+    if "reduction_of" in raw:
+        from .reduction import reduce_prestero  # a reduced preset: numbers from its 6-DOF data
+        speed = float(raw["u0"]["value"]) if u0 is None else u0
+        red = reduce_prestero(speed)
+        return VehiclePreset(
+            name=raw["name"], description=raw.get("description", ""), m=red["m"], d=red["d"],
+            wgml=red["wgml"], l=float(raw["l"]["value"]),
+            sources={**red["sources"], "l": {"unit": raw["l"]["unit"], "source": raw["l"]["source"]}},
+            u0=speed)
+    if u0 is not None:
+        raise ValueError(f"vehicle.u0: only a reduced preset has a linearisation speed; {name!r} is stored as numbers (got {u0!r})")
     vals = {k: raw[k]["value"] for k in _FIELDS}
     return VehiclePreset(
         name=raw["name"],
@@ -134,7 +160,7 @@ def vehicle_arrays(sc) -> tuple[np.ndarray, np.ndarray, dict]:
     record : dict
         Preset, numbers, sources and the true plant's numbers, for ``run.json``.
     """
-    pre = get_preset(sc.vehicle.preset)
+    pre = get_preset(sc.vehicle.preset, u0=getattr(sc.vehicle, "u0", None))
     v = sc.vehicle
     m = np.array(v.m if v.m is not None else pre.m, dtype=float)
     d = np.array(v.d if v.d is not None else pre.d, dtype=float)
@@ -144,7 +170,7 @@ def vehicle_arrays(sc) -> tuple[np.ndarray, np.ndarray, dict]:
     vp_nom = pack_vehicle(m, d, wgml, ell, 1.0)
     vp_true = pack_vehicle(m * (1 + u.M), d * (1 + u.D), wgml * (1 + u.G), ell, 1.0 + u.C)
     record = {"preset": pre.name, "m": m.tolist(), "d": d.tolist(), "wgml": wgml, "l": ell,
-              "sources": pre.sources,
+              "sources": pre.sources, **({"u0": pre.u0} if pre.u0 is not None else {}),
               "true_plant": {"m": (m * (1 + u.M)).tolist(), "d": (d * (1 + u.D)).tolist(),
                              "wgml": wgml * (1 + u.G), "c_scale": 1.0 + u.C}}
     return vp_nom, vp_true, record

@@ -35,6 +35,10 @@ class CompiledPlant:
         Messages to show the user.
     resolved : dict
         JSON record of the plant actually simulated (numbers and their sources) for ``run.json``.
+    module : str
+        Importable name of the module whose compiled functions run this plant; empty = the
+        registered spec's module.  A plant with presets of different equations (``"6dof"``)
+        names the preset's module here, so each gets its own kernel.
     """
 
     pp: np.ndarray
@@ -42,6 +46,7 @@ class CompiledPlant:
     log_names: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
     resolved: dict[str, Any] = field(default_factory=dict)
+    module: str = ""
 
 
 @dataclass(frozen=True)
@@ -58,12 +63,23 @@ class PlantSpec:
         ``setup(scenario) -> CompiledPlant``.
     summary : str
         One line for listings.
+    presets : dict of str to str
+        For a plant whose presets have different equations: preset name -> the module that
+        runs it (the module's ``MODULES``); empty when ``module`` runs every preset.
     """
 
     name: str
     module: str
     setup: Callable[..., CompiledPlant]
     summary: str = ""
+    presets: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def kernel_modules(self) -> dict[str, str]:
+        """Label -> module of every kernel this plant can need (one per preset module)."""
+        if not self.presets:
+            return {self.name: self.module}
+        return {f"{self.name}/{preset}": mod for preset, mod in self.presets.items()}
 
     @classmethod
     def from_module(cls, module: ModuleType) -> "PlantSpec":
@@ -88,7 +104,7 @@ class PlantSpec:
         if missing:
             raise TypeError(f"plant module {module.__name__} lacks {', '.join(missing)}")
         summary = (module.__doc__ or "").strip().splitlines()[0] if module.__doc__ else ""
-        return cls(module.NAME, module.__name__, module.setup, summary)
+        return cls(module.NAME, module.__name__, module.setup, summary, dict(getattr(module, "MODULES", {})))
 
 
 PLANTS: dict[str, PlantSpec] = {}

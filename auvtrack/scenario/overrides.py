@@ -24,7 +24,8 @@ __all__ = ["Override", "parse_overrides", "apply_overrides", "KIND_DEFAULTS"]
 
 Segment = str | int
 _SEGMENT = re.compile(r"^(?:[A-Za-z_][A-Za-z0-9_\-]*|\d+)$")
-_BARE_WORD = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-+]*$")
+# issue 11: a bare word may start with a digit when it has a letter (``plant.model=6dof``)
+_BARE_WORD = re.compile(r"^(?=.*[A-Za-z_])[A-Za-z0-9_][A-Za-z0-9_.\-+]*$")
 
 # Sections whose keys depend on ``kind`` (path without indices) and their default kind
 # (None: the kind is required).

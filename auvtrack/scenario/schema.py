@@ -17,7 +17,13 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_v
 from ..control import CONTROLLERS
 from ..control.params import FXTNTSMCParams, available_gain_presets, get_gain_preset
 from ..environment.current import MAX_SAMPLES as MAX_CURRENT_SAMPLES
-from ..plant.presets import available, get_preset
+from ..plant.presets import available, get_preset, is_reduced
+from ..plant.sixdof.presets import available6, load_preset6
+from ..plant.reduction import U0_MAX, U0_MIN, default_u0
+from ..plant.sixdof.truth import actuator_values
+from ..reference import build_reference
+
+DEFAULT_PLANT_PRESET = "remus100_prestero"
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
 from .names import check_name
@@ -25,7 +31,7 @@ from .names import check_name
 __all__ = [
     "CONTROLLER_MODELS", "ControllerParams", "Scenario", "SimSection", "VehicleSection",
     "UncertaintySection", "InitialSection", "EnvelopeSection", "EstimatorSection",
-    "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection", "LimitsSection",
+    "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection", "LimitsSection", "PlantSection",
 ]
 
 # --- strict scalar types ------------------------------------------------------------------------
@@ -101,6 +107,8 @@ class SimSection(_Section):
     log_dt: Pos = Field(0.01, description="logging interval, s (integer multiple of dt, divides duration)")
     control_rate: NonNeg = Field(0.0, description="Hz; 0 = continuous (every RK4 stage)")
     theta_limit: Annotated[Num, Field(gt=0, lt=90)] = Field(85.0, description="|pitch| stop, deg")
+    phi_limit: Annotated[Num, Field(gt=0, le=180)] = Field(  # issue 11: 6-DOF truth plants
+        85.0, description="|roll| stop, deg (6-DOF plants; the 5-DOF plant has no roll)")
     state_limit: Pos = Field(1e6, description="abs bound on every state before divergence")
     integrator: Literal["rk4"] = "rk4"
 
@@ -165,6 +173,11 @@ class VehicleSection(_Section):
     wgml: Coefficient | None = Field(None, description="rho g nabla GM_L, N m")
     l: Annotated[Num, Field(gt=0, le=10)] | None = Field(  # noqa: E741 - paper's symbol
         None, description="virtual-point offset ell, m (ell = 0 makes J3 singular)")
+    # --- issue 11: linearisation speed of a reduced preset (begin) -------------------------------
+    u0: Annotated[Num, Field(ge=U0_MIN, le=U0_MAX)] | None = Field(
+        None, description="linearisation speed of a reduced preset (remus100), m/s; default: the "
+                          "mean speed of the scenario's reference")
+    # --- issue 11 (end) --------------------------------------------------------------------------
 
     @model_validator(mode="before")
     @classmethod
@@ -177,7 +190,13 @@ class VehicleSection(_Section):
         names = available()
         if name not in names:
             raise ValueError(f"preset: unknown preset (allowed: {', '.join(names)}) (got {name!r})")
-        pre = get_preset(name)
+        # --- issue 11: a reduced preset is computed at vehicle.u0 (begin) ---
+        u0 = data.get("u0")
+        if u0 is not None and not is_reduced(name):
+            raise ValueError(f"u0: only a reduced preset ({', '.join(n for n in names if is_reduced(n))}) "
+                             f"has a linearisation speed; {name!r} has none (got {format_value(u0)})")
+        pre = get_preset(name, u0=u0 if isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX else None)
+        # --- issue 11 (end) ---
         out = dict(data)
         for key in _VEHICLE_FIELDS:
             if out.get(key) is None:
@@ -194,8 +213,10 @@ class VehicleSection(_Section):
             per number ``{"unit", "source", "origin"}`` with ``origin`` ``"preset"`` or
             ``"scenario"`` (an override differing from the preset value).
         """
-        pre = get_preset(self.preset)
+        pre = get_preset(self.preset, u0=self.u0)  # issue 11: reduced presets at u0
         out: dict[str, Any] = {"preset": pre.name, "description": pre.description}
+        if pre.u0 is not None:
+            out["u0"] = pre.u0
         sources: dict[str, dict[str, str]] = {}
         for key in _VEHICLE_FIELDS:
             value, preset_value = getattr(self, key), getattr(pre, key)
@@ -244,6 +265,9 @@ class InitialSection(_Section):
 
     eta: Vec5 = Field((0.0, 0.5, 0.0, 0.0, 0.0), description="m, m, m, rad, rad")
     nu: Vec5 = Field((0.0, 0.0, 0.0, 0.0, 0.0), description="m/s, m/s, m/s, rad/s, rad/s")
+    # issue 11: roll and roll rate of a 6-DOF truth plant (0 for the 5-DOF plant)
+    phi: Annotated[Num, Field(gt=-math.pi / 2, lt=math.pi / 2)] = Field(0.0, description="roll, rad (6-DOF plants)")
+    p: Annotated[Num, Field(ge=-10.0, le=10.0)] = Field(0.0, description="roll rate, rad/s (6-DOF plants)")
 
     @field_validator("eta")
     @classmethod
@@ -285,6 +309,69 @@ class SensorSection(_Section):
 
     sigma_eta: NonNeg5 = Field((0.0,) * 5, description="std of x, y, z (m), theta, psi (rad)")
     sigma_nu: NonNeg5 = Field((0.0,) * 5, description="std of u, v, w (m/s), q, r (rad/s)")
+
+
+# --- issue 11: the truth plant (begin) ---------------------------------------------------------
+PLANT_ACTUATOR_KEYS = ("delta_max", "n_max", "T_delta", "T_n", "delta_rate_max", "n_rate_max")
+
+
+class PlantSection(_Section):
+    """``[plant]``: the truth plant the controller flies (docs/vehicles.md).
+
+    ``model = "5dof"``: the paper's model with the ``[vehicle]`` numbers and ``[uncertainty]``;
+    ``model = "6dof"``: a 6-DOF truth model ``preset`` with fins, propeller and actuator states,
+    which the controller does not know (it keeps ``[vehicle]`` as its design model).  The
+    actuator keys override the preset's (6-DOF only).
+    """
+
+    model: Literal["5dof", "6dof"] = Field("5dof", description="'5dof' (paper eq. 1) or '6dof' (a truth preset)")
+    preset: Str | None = Field(None, description="6-DOF preset: remus100_prestero (default) or remus100_fossen")
+    delta_max: Annotated[Num, Field(gt=0, le=math.pi / 2)] | None = Field(None, description="fin angle limit, rad")
+    n_max: Pos | None = Field(None, description="propeller speed limit, rpm")
+    T_delta: Pos | None = Field(None, description="fin time constant, s")
+    T_n: Pos | None = Field(None, description="propeller time constant, s")
+    delta_rate_max: PosOrInf | None = Field(None, description="fin rate limit, rad/s (inf = none)")
+    n_rate_max: PosOrInf | None = Field(None, description="propeller rate limit, rpm/s (inf = none)")
+
+    @field_validator("delta_rate_max", "n_rate_max", mode="before")
+    @classmethod
+    def _word(cls, v: Any) -> Any:
+        return _inf_words([v])[0] if isinstance(v, str) else v
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_preset(cls, data: Any) -> Any:
+        if isinstance(data, Mapping) and data.get("model") == "6dof" and data.get("preset") is None:
+            return {**data, "preset": DEFAULT_PLANT_PRESET}
+        return data
+
+    @model_validator(mode="after")
+    def _preset(self) -> "PlantSection":
+        if self.model == "5dof":
+            given = [k for k in ("preset", *PLANT_ACTUATOR_KEYS) if getattr(self, k) is not None]
+            if given:
+                raise ValueError(f"{given[0]}: only for plant.model = \"6dof\" "
+                                 f"(got {format_value(getattr(self, given[0]))} with model \"5dof\")")
+            return self
+        names = available6()
+        if self.preset not in names:
+            raise ValueError(f"preset: unknown 6-DOF preset (allowed: {', '.join(names)}) (got {self.preset!r})")
+        try:
+            actuator_values(load_preset6(self.preset), self.actuator_overrides())
+        except ValueError as exc:  # "plant.<key>: ..." -> "<key>: ..."
+            raise ValueError(str(exc).removeprefix("plant.")) from None
+        return self
+
+    def actuator_overrides(self) -> dict[str, float]:
+        """The actuator keys given (6-DOF): name -> value."""
+        return {k: getattr(self, k) for k in PLANT_ACTUATOR_KEYS if getattr(self, k) is not None}
+
+    def actuator_limits(self) -> dict[str, float] | None:
+        """Effective actuator numbers of a 6-DOF plant (preset with overrides); None for 5dof."""
+        if self.model != "6dof":
+            return None
+        return actuator_values(load_preset6(self.preset), self.actuator_overrides())
+# --- issue 11 (end) ------------------------------------------------------------------------------
 
 
 class EnvelopeSection(_Section):
@@ -486,6 +573,29 @@ class Scenario(BaseModel):
     actuator: ActuatorSection = Field(default_factory=ActuatorSection)
     sensor: SensorSection = Field(default_factory=SensorSection)
     limits: LimitsSection = Field(default_factory=LimitsSection)
+    plant: PlantSection = Field(default_factory=PlantSection)  # issue 11
+
+    # --- issue 11: a reduced vehicle preset is linearised at the reference's speed (begin) -----
+    @model_validator(mode="before")
+    @classmethod
+    def _reduction_speed(cls, data: Any) -> Any:
+        """Fill ``vehicle.u0`` of a reduced preset with the mean speed of the reference."""
+        if not isinstance(data, Mapping):
+            return data
+        veh = data.get("vehicle", {})
+        if not isinstance(veh, Mapping) or veh.get("u0") is not None:
+            return data
+        name = veh.get("preset", "paper")
+        if not isinstance(name, str) or not is_reduced(name):
+            return data
+        try:  # an invalid reference or duration is reported by its own validator
+            ref = build_reference(check_reference(data.get("reference", {"kind": "helix"})))
+            sim = data.get("sim", {})
+            duration = float(sim.get("duration", SimSection.model_fields["duration"].default))
+        except (ValueError, TypeError, AttributeError):
+            return data
+        return {**data, "vehicle": {**veh, "u0": default_u0(ref, duration)}}
+    # --- issue 11 (end) ---------------------------------------------------------------------------
 
     @field_validator("name")
     @classmethod
@@ -524,6 +634,40 @@ class Scenario(BaseModel):
                 _check_numbers(model, v)
         return v
 
+    # --- issue 11: options that exist for one plant model only (begin) --------------------------
+    @model_validator(mode="after")
+    def _plant_options(self) -> "Scenario":
+        """5-DOF-only options with a 6-DOF truth, and roll initial values with the 5-DOF plant."""
+        if self.plant.model == "6dof":
+            default = UncertaintySection()
+            for k in ("C", "D", "M", "G"):
+                if getattr(self.uncertainty, k) != getattr(default, k):
+                    raise ValueError(f"uncertainty.{k}: scales the 5-DOF plant only; with plant.model = \"6dof\" "
+                                     f"the truth is the preset {self.plant.preset!r} (got {format_value(getattr(self.uncertainty, k))})")
+            for k in ("tau_max", "rate_max"):
+                v = getattr(self.actuator, k)
+                if any(math.isfinite(x) for x in v):
+                    raise ValueError(f"actuator.{k}: limits the 5-DOF input only; with plant.model = \"6dof\" the fins "
+                                     f"and propeller limit it (plant.delta_max, plant.n_max, ...) (got {format_value(v)})")
+            if self.controller.kind == "open_loop_actuators":
+                lim = self.plant.actuator_limits()
+                for k, cap, key in (("delta_r", lim["delta_max"], "delta_max"), ("delta_s", lim["delta_max"], "delta_max"),
+                                    ("rpm", lim["n_max"], "n_max")):
+                    v = getattr(self.controller, k)
+                    if abs(v) > cap:
+                        raise ValueError(f"controller.{k}: beyond the actuator limit plant.{key} = {cap:.6g} "
+                                         f"(got {format_value(v)})")
+        else:
+            if self.controller.kind == "open_loop_actuators":
+                raise ValueError("controller.kind: open_loop_actuators commands fins and propeller; it needs "
+                                 "plant.model = \"6dof\" (got 'open_loop_actuators' with plant.model \"5dof\")")
+            for k in ("phi", "p"):
+                if getattr(self.initial, k) != 0.0:
+                    raise ValueError(f"initial.{k}: roll exists only with plant.model = \"6dof\" "
+                                     f"(got {format_value(getattr(self.initial, k))})")
+        return self
+    # --- issue 11 (end) ---------------------------------------------------------------------------
+
     @model_validator(mode="after")
     def _start_inside_limits(self) -> "Scenario":
         """A start beyond the pitch limit would stop the run at t = 0."""
@@ -553,4 +697,8 @@ class Scenario(BaseModel):
         lists and an infinite value (``metrics.window[1]``) is written as the string ``"inf"``.
         ``load_scenario(s.to_dict()) == s``.
         """
-        return jsonable(self.model_dump(mode="python"))
+        out = jsonable(self.model_dump(mode="python"))
+        if out["vehicle"].get("u0") is None:  # issue 11: only a reduced preset has a u0
+            out["vehicle"].pop("u0", None)
+        out["plant"] = {k: v for k, v in out["plant"].items() if v is not None}  # issue 11: 6-DOF-only keys
+        return out

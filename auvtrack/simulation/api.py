@@ -7,6 +7,8 @@ controller's set-up: everything becomes packed float64 arrays, bundled as the en
 """
 from __future__ import annotations
 
+import importlib
+
 import math
 import threading
 import time
@@ -198,7 +200,8 @@ def prepare(scenario: Scenario) -> Prepared:
     if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
     noise = noise_table(sc.seed, plan.control_samples if ctrl_every else 1, sigma)
-    key = kernels.KernelKey(cc.law or cspec.module, plant_spec.module, f"{cspec.name} on {plant_spec.name}")
+    key = kernels.KernelKey(cc.law or cspec.module, cpl.module or plant_spec.module,
+                            f"{cspec.name} on {plant_spec.name}")
     return Prepared(
         scenario=sc, key=key,
         plant=PlantBundle(_c(cpl.pp), _c(cpl.x0)),
@@ -373,7 +376,10 @@ def failure_record(cause: int, t: float, fail_state: np.ndarray, prep: Prepared)
 
 def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
     nxp = prep.plant.x0.size
-    st: dict[str, Any] = {n: float(state[i]) for i, n in enumerate(STATE_NAMES)}
+    # the 5-DOF names label the plant's pose (a 6-DOF state has roll at index 3)
+    pose = importlib.import_module(prep.key.plant).pose
+    eta, nu = pose(np.ascontiguousarray(state[:nxp], dtype=np.float64))
+    st: dict[str, Any] = {n: float(v) for n, v in zip(STATE_NAMES, (*eta, *nu))}
     if nxp > len(STATE_NAMES):
         st["plant_state"] = [float(x) for x in state[:nxp]]
     if state.size > nxp:

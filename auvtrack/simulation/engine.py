@@ -210,6 +210,13 @@ def state_cause(xp, xc, sf):
     return CAUSE_NONE
 
 
+@kernel_part("njit_noalloc(inline='always')")
+def plant_attitude(xp):
+    """(cos theta, sin theta, cos psi, sin psi) of the plant state, through its 5-DOF ``pose``."""
+    eta = plant.pose(xp)[0]  # noqa: F821  (bound per kernel)
+    return attitude(eta[3], eta[4])
+
+
 @kernel_part("njit_noalloc")
 def stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd, dxp, dxc, tau, aux,
           fresh):
@@ -307,7 +314,7 @@ def run(pb, cb, env, ref_p, settings, out):
             for i in range(nxc):  # the held controller derivative, for every stage until the next sample
                 kc2[i] = kc3[i] = kc4[i] = kc1[i]
         # stage 1 at (t, x): also the values that are logged and enter the metrics
-        att = attitude(xp[3], xp[4])
+        att = plant_attitude(xp)
         status, flags = stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd,
                               kp1, kc1, tau1, aux1, True)
         if ctrl_every == 0:
@@ -332,21 +339,21 @@ def run(pb, cb, env, ref_p, settings, out):
             xps[i] = xp[i] + 0.5 * dt * kp1[i]
         for i in range(nxc):
             xcs[i] = xc[i] + 0.5 * dt * kc1[i]
-        status, _ = stage(t + 0.5 * dt, xps, xcs, attitude(xps[3], xps[4]), ctrl_every, cp, vp, pp, ref_p, rows,
+        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p, rows,
                           current, refm, work, scr, cmd, kp2, kc2, tau, aux, True)
         if status == 0:
             for i in range(nxp):
                 xps[i] = xp[i] + 0.5 * dt * kp2[i]
             for i in range(nxc):
                 xcs[i] = xc[i] + 0.5 * dt * kc2[i]
-            status, _ = stage(t + 0.5 * dt, xps, xcs, attitude(xps[3], xps[4]), ctrl_every, cp, vp, pp, ref_p,
+            status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p,
                               rows, current, refm, work, scr, cmd, kp3, kc3, tau, aux, not reuse)
         if status == 0:
             for i in range(nxp):
                 xps[i] = xp[i] + dt * kp3[i]
             for i in range(nxc):
                 xcs[i] = xc[i] + dt * kc3[i]
-            status, _ = stage(t + dt, xps, xcs, attitude(xps[3], xps[4]), ctrl_every, cp, vp, pp, ref_p, rows,
+            status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p, rows,
                               current, refm, work, scr, cmd, kp4, kc4, tau, aux, True)
         if status != 0:
             record_stop(xp, xc, xp, xc, fail_state)
