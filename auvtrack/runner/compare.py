@@ -251,19 +251,31 @@ def manifest_for(suite, entries: Sequence, chunk_size: int, n_runs: int) -> dict
             "auvtrack_version": __version__, "source_hash": src}
 
 
-def _warm(specs: Sequence[RunSpec]) -> float:
-    """Compile or load every kernel the runs need (one prepared run per controller and plant)."""
+def _warm(specs: Sequence[RunSpec], workers: int | None = None) -> float:
+    """Compile or load everything the runs need before the timed runs start.
+
+    One run per (controller, tier, plant preset) is prepared (set-up helpers compile on first
+    use), its kernel compiled or loaded, and then flown for 0.5 s: a kernel compiles one
+    specialisation per type signature of its bundles, and the tiers' bundles differ, so this
+    loads every signature the runs will call.
+    """
     from ..simulation.api import ensure_compiled
+    from .batch import run_batch
 
     t0 = time.perf_counter()
     seen: dict[tuple, Any] = {}
     for s in specs:
-        key = (s.controller, s.overrides.get("plant.model", "5dof"), s.overrides.get("plant.preset"))
+        key = (s.controller, s.tier, s.overrides.get("plant.preset"))
         if key not in seen:
-            p = _prepare(s)
+            sim = {**s.raw.get("sim", {}), "duration": min(0.5, float(s.raw.get("sim", {}).get("duration", 0.5)))}
+            short = RunSpec(s.run, s.controller, s.task, s.tier, s.index, {**s.raw, "sim": sim}, s.overrides,
+                            s.drawn)
+            p = _prepare(short)
             if not isinstance(p, str):
                 seen[key] = p
     ensure_compiled(list(seen.values()), progress=True)
+    if seen:
+        run_batch(list(seen.values()), workers=workers)
     return time.perf_counter() - t0
 
 
@@ -324,7 +336,7 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
 
         local = client is None and scheduler is None
         if local:
-            compile_s = _warm(specs)
+            compile_s = _warm(specs, workers)
         n_done = sum(len(chunks[c]) for c in done)
         bar = tqdm(total=len(specs), initial=n_done, unit="run", desc=suite.name + (" (quick)" if suite.quick else ""),
                    disable=not progress, smoothing=0.05)

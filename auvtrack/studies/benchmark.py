@@ -11,6 +11,7 @@ and writes the report (:mod:`auvtrack.studies.compare_report`): ``report.md``, `
 """
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,6 +50,14 @@ class CompareOutcome:
     report: Path | None
     execution: runner.ExecOutcome
     analysis_seconds: float
+
+
+def _load_average() -> list[float] | None:
+    """The 1, 5 and 15 minute load averages (None where the OS has none): the machine's load, for the timing."""
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except (AttributeError, OSError):
+        return None
 
 
 def default_out(suite: Suite) -> Path:
@@ -185,8 +194,10 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     ents = list(entries) if entries is not None else resolve_controllers(
         list(controllers) if controllers else None, list(plugins or []), s.file.gain_preset)
     folder = Path(out) if out is not None else default_out(s)
+    load0 = _load_average()
     ex = runner.execute(s, ents, folder, resume=resume, scheduler=scheduler, client=client, workers=workers,
                         chunk_size=chunk_size, max_chunks=max_chunks, progress=progress)
+    load1 = _load_average()
     if not ex.complete:
         return CompareOutcome(folder, False, None, ex, 0.0)
     t0 = time.perf_counter()
@@ -198,6 +209,7 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     reps = _representative_runs(s, ents, seeds, workers)
     timing = {"runs_seconds": ex.seconds, "compile_seconds": ex.compile_seconds, "chunks_run": ex.chunks_run,
               "chunks_resumed": ex.chunks_skipped, "runs": ex.runs, "backend": "dask" if (scheduler or client)
-              else "local threads"}
+              else "local threads", "workers": workers, "cpu_count": os.cpu_count(),
+              "load_average_start": load0, "load_average_end": load1}
     report = write_report(folder, s, ents, df, analysis, seeds, reps, timing, t0)
     return CompareOutcome(folder, True, report, ex, time.perf_counter() - t0)

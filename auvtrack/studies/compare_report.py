@@ -204,6 +204,10 @@ def _settings_rows(suite: Suite) -> list[list]:
             ["fingerprint", suite.fingerprint()[:16]]]
 
 
+def _load(avg) -> str:
+    return "n/a" if not avg else "/".join(f"{x:.2f}" for x in avg)
+
+
 def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df, analysis: Mapping,
                  seeds: Mapping, reps: Mapping, timing: dict, t_analysis0: float) -> Path:
     """Write ``report.md`` (and ``report.html``), ``results.json`` and the figures under ``out``.
@@ -328,9 +332,12 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
     cmd = "auvtrack compare --suite " + suite.name + (" --quick" if suite.quick else "")
     rep.paragraph(f"`{cmd}` with auvtrack {__version__} (sources {source_hash()[:12]}) gives the same numbers "
                   "(every random number derives from the suite seed). Wall time of the runs: "
-                  f"{timing['runs_seconds']:.1f} s ({timing['backend']}, {timing['chunks_run']} chunks run now, "
-                  f"{timing['chunks_resumed']} resumed), on {platform.machine()} / Python "
-                  f"{platform.python_version()}.")
+                  f"{timing['runs_seconds']:.1f} s after {timing['compile_seconds']:.1f} s of kernel compilation "
+                  f"or loading ({timing['backend']}, {timing['chunks_run']} chunks run now, "
+                  f"{timing['chunks_resumed']} resumed), on {platform.machine()} with "
+                  f"{timing.get('cpu_count')} cores / Python {platform.python_version()}; load average (1, 5, "
+                  f"15 min) {_load(timing.get('load_average_start'))} at the start, "
+                  f"{_load(timing.get('load_average_end'))} at the end of the runs.")
     rep.scenario(suite.text or suite.settings(), f"Suite `{suite.name}` ({suite.source}): every task, tier and "
                  "setting of the runs (each run's scenario: `auvtrack.studies.suite.Suite.scenario`)")
     report = rep.write()

@@ -206,16 +206,16 @@ class ControllerEntry:
 
 
 def tracking_kinds() -> list[str]:
-    """Registered controllers that track a reference: every kind but the open-loop and plug-in loaders.
+    """Built-in controllers that track a reference: :data:`auvtrack.control.BUILTIN_NAMES` but the open-loop kinds.
 
     Returns
     -------
     list of str
         Kinds in registration order.
     """
-    from ..control import CONTROLLERS
+    from ..control import BUILTIN_NAMES
 
-    return [k for k in CONTROLLERS if not k.startswith("open_loop") and k != "plugin"]
+    return [k for k in BUILTIN_NAMES if not k.startswith("open_loop")]
 
 
 def _builtin_entry(kind: str, pattern: str) -> ControllerEntry:
@@ -264,12 +264,12 @@ def resolve_controllers(names: list[str] | None = None, plugins: list[str | Path
     SuiteError
         An unknown or repeated kind, a missing plug-in file, or no controller at all.
     """
-    from ..control import CONTROLLERS
+    from ..control import BUILTIN_NAMES
 
     kinds = tracking_kinds() if not names else list(names)
     entries: list[ControllerEntry] = []
     for k in kinds:
-        if k not in CONTROLLERS or k == "plugin":
+        if k not in BUILTIN_NAMES:
             raise SuiteError(f"--controllers: unknown controller {k!r} (allowed: {', '.join(tracking_kinds())}; "
                              "plug-in files with --plugin)")
         if any(e.label == k for e in entries):
