@@ -333,11 +333,14 @@ def _split_names(values: tuple[str, ...]) -> list[str]:
               help="Output folder (default compare/<suite>, compare/<suite>-quick with --quick).")
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Run on an existing Dask scheduler, tcp://host:port.")
 @click.option("--workers", type=int, default=None, help="Local threads (default: every core).")
+@click.option("--backend", default=None, metavar="NAME",
+              help="Back end of the batch runner (auvtrack.runner.batch.BACKENDS; default: its default).")
 @click.option("--resume", is_flag=True, help="Finish an interrupted comparison in --out (completed chunks are kept).")
 @click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, ...], quick: bool, out: str | None,
-            scheduler: str | None, workers: int | None, resume: bool, max_chunks: int | None, quiet: bool) -> None:
+            scheduler: str | None, workers: int | None, backend: str | None, resume: bool, max_chunks: int | None,
+            quiet: bool) -> None:
     """Benchmark the controllers over a suite's tasks x tiers x seeds; write report.md/.html, results.json, runs.parquet.
 
     Every registered tracking controller runs with its tuned gain preset ({kind}_tuned) or, without one, its
@@ -368,7 +371,7 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
     previous = signal.signal(signal.SIGTERM, _stop)
     try:
         res = _compare(suite, controllers=_split_names(controllers) or None, plugins=list(plugins), out=folder,
-                       scheduler=scheduler, workers=workers, resume=resume, max_chunks=max_chunks,
+                       scheduler=scheduler, workers=workers, backend=backend, resume=resume, max_chunks=max_chunks,
                        progress=not quiet)
     except (SuiteError, CompareError) as exc:
         raise BadInput(_one_line(exc)) from None

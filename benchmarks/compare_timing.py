@@ -2,7 +2,8 @@
 
 Usage: ``python benchmarks/compare_timing.py [--skip-default] [--workers N] [--out DIR]``.
 
-A first ``--quick`` comparison compiles (or loads) every kernel and is timed as "cold"; then, in the
+A first ``--quick`` comparison compiles every kernel the disk cache lacks, or loads it, and is timed as
+"cold" (its compile/load column says which happened); then, in the
 same process, ``--quick`` and the default suite run again with everything compiled.  The numbers
 written to ``benchmarks/compare_timing.{json,md}`` are the reports' own timing blocks
 (``results.json`` -> ``timing``: runs, compilation, analysis, load averages) plus the wall time of
@@ -20,6 +21,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import pandas as pd
+
 from auvtrack import __version__
 from auvtrack.studies.benchmark import compare
 
@@ -35,11 +38,14 @@ def _one(label: str, out: Path, quick: bool, workers: int | None) -> dict:
     timing = doc["timing"]
     after = timing["runs_seconds"] + timing["analysis_seconds"]
     target = TARGETS[label]
+    runs = pd.read_parquet(out / "runs.parquet", columns=["task", "steps"])
+    dt_ = float(doc["suite"]["file"]["base"].get("sim.dt", 0.002))
+    full = runs["task"].map(lambda t: round(doc["suite"]["durations"][t] / dt_)).sum()
     return {"variant": label, "out": str(out), "runs": timing["runs"], "seeds": doc["suite"]["seeds"],
             "controllers": len(doc["controllers"]), "tiers": len(doc["suite"]["file"]["tiers"]) -
             len(doc["suite"]["skipped_tiers"]), "wall_seconds": wall, "after_compilation_seconds": after,
             "target_seconds": target, "meets_target": None if target is None else after <= target,
-            "source_hash": doc["source_hash"], "complete": res.complete, **timing}
+            "steps": int(runs["steps"].sum()), "steps_full": int(full), "source_hash": doc["source_hash"], "complete": res.complete, **timing}
 
 
 def _cpu() -> str:
@@ -60,14 +66,16 @@ def _markdown(doc: dict) -> str:
              "report (the `timing` block of each report's `results.json`); the cold row also compiles or loads "
              "the kernels.", "",
              "| variant | runs | runs (s) | compile/load (s) | statistics + report (s) | after compilation (s) "
-             "| target (s) | meets | load avg at start | load avg at end |", "|" + "---|" * 10]
+             "| target (s) | meets | RK4 steps flown / at full durations | load avg at start | load avg at end |",
+             "|" + "---|" * 11]
     for r in doc["rows"]:
         tgt = "" if r["target_seconds"] is None else f"{r['target_seconds']:.0f}"
         ok = "" if r["meets_target"] is None else ("yes" if r["meets_target"] else "**no**")
         la = "/".join(f"{x:.2f}" for x in r["load_average_start"] or [])
         lb = "/".join(f"{x:.2f}" for x in r["load_average_end"] or [])
         lines.append(f"| {r['variant']} | {r['runs']} | {r['runs_seconds']:.1f} | {r['compile_seconds']:.1f} | "
-                     f"{r['analysis_seconds']:.1f} | {r['after_compilation_seconds']:.1f} | {tgt} | {ok} | {la} | "
+                     f"{r['analysis_seconds']:.1f} | {r['after_compilation_seconds']:.1f} | {tgt} | {ok} | "
+                     f"{r['steps'] / r['steps_full']:.2f} | {la} | "
                      f"{lb} |")
     return "\n".join(lines) + "\n"
 

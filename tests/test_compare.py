@@ -65,9 +65,14 @@ def _results(out: Path) -> dict:
 
 
 def test_quick_path_every_controller_and_tier_and_the_report_files(quick):
+    from auvtrack import __version__
+    from auvtrack.control import BUILTIN_NAMES
+    from auvtrack.control.params import available_gain_presets
+
     suite = load_suite().quick_variant()
     doc = json.loads((quick / "results.json").read_text())
     kinds = tracking_kinds()
+    assert kinds == [k for k in BUILTIN_NAMES if not k.startswith("open_loop")] and len(kinds) >= 6
     assert sorted(r["controller"] for r in doc["leaderboard"]) == sorted(kinds)
     assert {c["tier"] for c in doc["cells"]} == set(suite.tiers)
     assert {c["task"] for c in doc["cells"]} == set(suite.tasks)
@@ -84,8 +89,58 @@ def test_quick_path_every_controller_and_tier_and_the_report_files(quick):
         assert (quick / "figures" / f"{fig}.png").is_file()
     html = check_html_report(quick)
     assert "Leaderboard" in html and suite.name in html
+    # every built-in enters with its tuned preset, or with its defaults and the report says so
+    assert [c["label"] for c in doc["controllers"]] == kinds
+    for c in doc["controllers"]:
+        preset = f"{c['label']}_tuned"
+        if preset in available_gain_presets():
+            assert c["table"] == {"kind": c["label"], "preset": preset} and preset in md
+        else:
+            assert c["table"] == {"kind": c["label"]} and "package defaults" in c["gains"] and "package defaults" in md
+    # comparable reports: suite version, every setting, package version and sources
     assert doc["suite"]["name"] == "auv-track-v1" and doc["suite"]["quick"] is True
-    assert doc["auvtrack_version"] and len(doc["source_hash"]) == 64
+    assert doc["suite"]["version"] == suite.file.version and doc["suite"]["file"] == suite.file.model_dump(mode="json")
+    assert doc["suite"] == json.loads(json.dumps(suite.settings()))
+    assert doc["auvtrack_version"] == __version__ and len(doc["source_hash"]) == 64
+    assert f"auvtrack {__version__}" in md and f"version {suite.file.version}" in md and suite.fingerprint()[:16] in md
+    t = doc["timing"]
+    assert t["runs"] == len(runs) and t["cpu_count"] and t["compile_seconds"] >= 0 and "load average" in md
+
+
+def test_quick_path_truth6_flies_both_6dof_presets(quick):
+    """The truth6 tier cycles the two shipped 6-DOF truth plants over the seeds; every controller flies both,
+    and a truth6 row is the single run of its scenario on that 6-DOF plant."""
+    from auvtrack.plant.sixdof.presets import SHIPPED6
+    from auvtrack.scenario import load_scenario
+    from auvtrack.simulation.api import simulate
+
+    suite = load_suite().quick_variant()
+    assert "truth6" in suite.tiers and not suite.skipped_tiers
+    runs = pd.read_parquet(quick / "runs.parquet")
+    truth = runs[runs["tier"] == "truth6"].assign(preset=lambda d: d["draws"].map(lambda x: json.loads(x)["plant.preset"]))
+    assert set(truth["preset"]) == set(SHIPPED6)
+    for (controller, preset), g in truth.groupby(["controller", "preset"]):
+        assert (g["cause"] != "setup").all() and (g["steps"] > 0).all(), (controller, preset)
+    assert set(truth.groupby(["controller", "preset"]).groups) == {(c, p) for c in tracking_kinds() for p in SHIPPED6}
+    entries = {e.label: e for e in resolve_controllers()}
+    row = truth[(truth["preset"] == "remus100_fossen") & (truth["status"] == "ok")].iloc[0]
+    raw, ov, _ = suite.scenario(entries[row.controller], row.task, "truth6", int(row.seed_index))
+    sc = load_scenario(raw, ov)
+    assert sc.plant.model == "6dof" and sc.plant.preset == "remus100_fossen"
+    res = simulate(sc)
+    assert res.status == row.status and res.metrics["rmse_x"] == row["rmse_x"] and res.metrics["itae_z"] == row["itae_z"]
+
+
+def test_controllers_without_a_tuned_preset_run_on_defaults_and_the_report_says_so(tiny, tmp_path):
+    path = tmp_path / "untuned.toml"
+    path.write_text(TINY.replace('seed = 5', 'seed = 5\ngain_preset = "{kind}_untuned"', 1))
+    entry, = resolve_controllers(["ftsmc"], gain_preset="{kind}_untuned")
+    assert entry.table == {"kind": "ftsmc"} and "package defaults" in entry.gains
+    res = compare(path, quick=True, controllers=["ftsmc"], out=tmp_path / "u", progress=False)
+    doc = json.loads((tmp_path / "u" / "results.json").read_text())
+    assert doc["controllers"] == [entry.to_dict()]
+    md = res.report.read_text()
+    assert "package defaults" in md and "without a tuned gain preset" in md
 
 
 def test_quick_path_numbers_are_the_runs_numbers(quick):
@@ -107,7 +162,7 @@ def test_quick_path_numbers_are_the_runs_numbers(quick):
 
 def test_same_suite_same_seeds_identical_numbers(tiny, tmp_path):
     a = compare(tiny, out=tmp_path / "a", progress=False)
-    b = compare(tiny, out=tmp_path / "b", progress=False, chunk_size=5)  # chunking must not matter
+    b = compare(tiny, out=tmp_path / "b", progress=False, chunk_size=5, backend="serial")  # nor chunks, back end
     assert a.complete and b.complete
     assert _results(tmp_path / "a") == _results(tmp_path / "b")
     ra, rb = pd.read_parquet(tmp_path / "a" / "runs.parquet"), pd.read_parquet(tmp_path / "b" / "runs.parquet")
@@ -177,6 +232,7 @@ def test_plan_is_every_controller_task_tier_and_seed(tiny):
     (["--controllers", "pid2"], "--controllers: unknown controller 'pid2'"),
     (["--plugin", "missing.py"], "--plugin: must be an existing .py file"),
     (["--workers", "0"], "--workers: must be >= 1"),
+    (["--backend", "nope"], "--backend: must be one of threads"),
 ])
 def test_bad_options_exit_2_with_one_line(args, expect, tmp_path, capsys):
     assert main(["compare", "--out", str(tmp_path / "x"), "--quiet", *args]) == EXIT_BAD_INPUT

@@ -123,7 +123,12 @@ def _prepare(spec: RunSpec):
         return " ".join(str(exc).split()) or type(exc).__name__
 
 
-def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1):
+def _backend_kw(backend: str | None) -> dict:
+    """``run_batch`` keywords for ``backend`` (None: the batch runner's own default back end)."""
+    return {} if backend is None else {"backend": backend}
+
+
+def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1, backend: str | None = None):
     """Prepare and run ``specs`` (metrics only) and return one row per run as an Arrow table.
 
     A run whose set-up is refused (a controller rejecting its gains or the start, a plug-in that
@@ -136,7 +141,10 @@ def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1):
         The chunk's runs.
     workers : int or None, optional
         Threads of :func:`auvtrack.runner.batch.run_batch` (None: every core; 1 on a Dask
-        worker, which is single-threaded); its default back end is used.
+        worker, which is single-threaded).
+    backend : str, optional
+        A back end of :func:`auvtrack.runner.batch.run_batch` (one of its ``BACKENDS``); default:
+        the batch runner's default.
 
     Returns
     -------
@@ -153,7 +161,7 @@ def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1):
     schema = _schema()
     prepared = [_prepare(s) for s in specs]
     runnable = [p for p in prepared if not isinstance(p, str)]
-    summaries = iter(run_batch(runnable, workers=workers))
+    summaries = iter(run_batch(runnable, workers=workers, **_backend_kw(backend)))
     cols: dict[str, list] = {f.name: [] for f in schema}
     for spec, prep in zip(specs, prepared):
         row: dict[str, Any] = {"run": spec.run, "controller": spec.controller, "task": spec.task, "tier": spec.tier,
@@ -235,7 +243,7 @@ def _prepare_out(out: Path, manifest: dict, n_chunks: int, resume: bool) -> set[
     return done
 
 
-def manifest_for(suite, entries: Sequence, chunk_size: int, n_runs: int) -> dict:
+def manifest_for(suite, entries: Sequence, chunk_size: int, n_runs: int, backend: str | None = None) -> dict:
     """The ``compare.json`` of a comparison (its fingerprint covers suite, controllers and sources)."""
     import hashlib
 
@@ -245,13 +253,15 @@ def manifest_for(suite, entries: Sequence, chunk_size: int, n_runs: int) -> dict
     controllers = [e.to_dict() for e in entries]
     src = source_hash()
     doc = {"suite": suite.fingerprint(), "controllers": controllers, "chunk_size": chunk_size, "source": src}
+    if backend is not None:
+        doc["backend"] = backend
     fp = hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()
     return {"fingerprint": fp, "suite_fingerprint": suite.fingerprint(), "suite": suite.name,
             "quick": suite.quick, "controllers": controllers, "runs": n_runs, "chunk_size": chunk_size,
             "auvtrack_version": __version__, "source_hash": src}
 
 
-def _warm(specs: Sequence[RunSpec], workers: int | None = None) -> float:
+def _warm(specs: Sequence[RunSpec], workers: int | None = None, backend: str | None = None) -> float:
     """Compile or load everything the runs need before the timed runs start.
 
     One run per (controller, tier, plant preset) is prepared (set-up helpers compile on first
@@ -275,12 +285,13 @@ def _warm(specs: Sequence[RunSpec], workers: int | None = None) -> float:
                 seen[key] = p
     ensure_compiled(list(seen.values()), progress=True)
     if seen:
-        run_batch(list(seen.values()), workers=workers)
+        run_batch(list(seen.values()), workers=workers, **_backend_kw(backend))
     return time.perf_counter() - t0
 
 
 def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, scheduler: str | None = None,
-            client: Any = None, workers: int | None = None, chunk_size: int = 48, max_chunks: int | None = None,
+            client: Any = None, workers: int | None = None, backend: str | None = None, chunk_size: int = 48,
+            max_chunks: int | None = None,
             progress: bool = True, on_chunk: Callable[[int], None] | None = None) -> ExecOutcome:
     """Run (or resume) every run of a comparison and write ``chunks/`` and, when complete, ``runs.parquet``.
 
@@ -300,6 +311,9 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
         An existing Dask client (overrides ``scheduler``; left open).
     workers : int, optional
         Local threads (default: every core).
+    backend : str, optional
+        Back end of :func:`auvtrack.runner.batch.run_batch` for every chunk, local or on Dask
+        (default: the batch runner's default).  A named back end is part of the fingerprint.
     chunk_size : int, optional
         Runs per chunk (per Parquet file, per Dask task).
     max_chunks : int, optional
@@ -325,10 +339,15 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
         raise CompareError(f"chunk_size: must be >= 1 (got {chunk_size})")
     if workers is not None and workers < 1:
         raise CompareError(f"--workers: must be >= 1 (got {workers})")
+    if backend is not None:
+        from .batch import BACKENDS
+
+        if backend not in BACKENDS:
+            raise CompareError(f"--backend: must be one of {', '.join(BACKENDS)} (got {backend!r})")
     out = Path(out)
     specs = plan_runs(suite, entries)
     chunks = [specs[i:i + chunk_size] for i in range(0, len(specs), chunk_size)]
-    done = _prepare_out(out, manifest_for(suite, entries, chunk_size, len(specs)), len(chunks), resume)
+    done = _prepare_out(out, manifest_for(suite, entries, chunk_size, len(specs), backend), len(chunks), resume)
     todo = [c for c in range(len(chunks)) if c not in done]
     written, seconds, compile_s = 0, 0.0, 0.0
     if todo:
@@ -336,7 +355,7 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
 
         local = client is None and scheduler is None
         if local:
-            compile_s = _warm(specs, workers)
+            compile_s = _warm(specs, workers, backend)
         n_done = sum(len(chunks[c]) for c in done)
         bar = tqdm(total=len(specs), initial=n_done, unit="run", desc=suite.name + (" (quick)" if suite.quick else ""),
                    disable=not progress, smoothing=0.05)
@@ -344,7 +363,7 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
             if local:
                 t0 = time.perf_counter()
                 for c in todo:
-                    table = run_chunk(chunks[c], workers=workers)
+                    table = run_chunk(chunks[c], workers=workers, backend=backend)
                     _write_atomic_table(table, chunk_path(out, c))
                     written += 1
                     bar.update(table.num_rows)
@@ -354,7 +373,8 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
                         break
                 seconds = time.perf_counter() - t0
             else:
-                written, seconds = _on_dask(out, chunks, todo, client, scheduler, bar, max_chunks, on_chunk)
+                written, seconds = _on_dask(out, chunks, todo, client, scheduler, bar, max_chunks, on_chunk,
+                                            backend)
         finally:
             bar.close()
     complete = all(chunk_path(out, c).exists() for c in range(len(chunks)))
@@ -363,7 +383,8 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
     return ExecOutcome(out, complete, len(specs), written, len(done), seconds, compile_s)
 
 
-def _on_dask(out: Path, chunks, todo, client, scheduler, bar, max_chunks, on_chunk) -> tuple[int, float]:
+def _on_dask(out: Path, chunks, todo, client, scheduler, bar, max_chunks, on_chunk,
+             backend: str | None = None) -> tuple[int, float]:
     from dask.distributed import Client, as_completed
 
     from .sweep_worker import WarmupPlugin
@@ -376,7 +397,7 @@ def _on_dask(out: Path, chunks, todo, client, scheduler, bar, max_chunks, on_chu
         client.register_plugin(WarmupPlugin(), name=WarmupPlugin.name)
         token = uuid.uuid4().hex[:10]
         t0 = time.perf_counter()
-        futures = [client.submit(run_chunk, chunks[c], key=f"auvtrack-compare-{token}-{c}", retries=1) for c in todo]
+        futures = [client.submit(run_chunk, chunks[c], backend=backend, key=f"auvtrack-compare-{token}-{c}", retries=1) for c in todo]
         chunk_of = {f.key: c for f, c in zip(futures, todo)}
         try:
             for fut in as_completed(futures):

@@ -60,6 +60,14 @@ def _load_average() -> list[float] | None:
         return None
 
 
+def _default_backend() -> str:
+    import inspect
+
+    from ..runner.batch import run_batch
+
+    return str(inspect.signature(run_batch).parameters["backend"].default)
+
+
 def default_out(suite: Suite) -> Path:
     """``compare/<suite>`` (``compare/<suite>-quick`` for the quick variant)."""
     return Path("compare") / (suite.name + ("-quick" if suite.quick else ""))
@@ -147,7 +155,8 @@ def _representative_runs(suite: Suite, entries: Sequence[ControllerEntry], seeds
 
 def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[str] | None = None,
             plugins: Sequence[str | Path] | None = None, quick: bool = False, out: str | Path | None = None,
-            scheduler: str | None = None, client: Any = None, workers: int | None = None, resume: bool = False,
+            scheduler: str | None = None, client: Any = None, workers: int | None = None,
+            backend: str | None = None, resume: bool = False,
             progress: bool = True, max_chunks: int | None = None, chunk_size: int = 48,
             entries: Sequence[ControllerEntry] | None = None) -> CompareOutcome:
     """Run a benchmark comparison and write its report.
@@ -170,6 +179,8 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
         An existing Dask client (tests).
     workers : int, optional
         Local threads.
+    backend : str, optional
+        Back end of the batch runner (:data:`auvtrack.runner.batch.BACKENDS`); default its default.
     resume : bool, optional
         Finish an interrupted comparison in ``out``.
     progress : bool, optional
@@ -195,7 +206,7 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
         list(controllers) if controllers else None, list(plugins or []), s.file.gain_preset)
     folder = Path(out) if out is not None else default_out(s)
     load0 = _load_average()
-    ex = runner.execute(s, ents, folder, resume=resume, scheduler=scheduler, client=client, workers=workers,
+    ex = runner.execute(s, ents, folder, resume=resume, scheduler=scheduler, client=client, workers=workers, backend=backend,
                         chunk_size=chunk_size, max_chunks=max_chunks, progress=progress)
     load1 = _load_average()
     if not ex.complete:
@@ -209,7 +220,7 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     reps = _representative_runs(s, ents, seeds, workers)
     timing = {"runs_seconds": ex.seconds, "compile_seconds": ex.compile_seconds, "chunks_run": ex.chunks_run,
               "chunks_resumed": ex.chunks_skipped, "runs": ex.runs, "backend": "dask" if (scheduler or client)
-              else "local threads", "workers": workers, "cpu_count": os.cpu_count(),
+              else "local threads", "workers": workers, "batch_backend": backend or _default_backend(), "cpu_count": os.cpu_count(),
               "load_average_start": load0, "load_average_end": load1}
     report = write_report(folder, s, ents, df, analysis, seeds, reps, timing, t0)
     return CompareOutcome(folder, True, report, ex, time.perf_counter() - t0)
