@@ -422,7 +422,11 @@ class _StudyCommand(click.Command):
 @click.argument("name")
 @click.option("--out", type=click.Path(file_okay=False), default=None, help="Output folder (default studies/<NAME>).")
 @click.option("--quick", is_flag=True, help="CI-sized run (seconds instead of minutes).")
-def study(name: str, out: str | None, quick: bool) -> None:
+@click.option("--pulse", default=None, metavar="F1,F2,F3,F4,F5",
+              help="ablation: one pulse direction (N, N, N, N m, N m per unit amplitude) instead of the defaults.")
+@click.option("--pulse-start", "pulse_start", type=float, default=None, metavar="T",
+              help="ablation: pulse onset in s (default 20; the run lasts until T + 20 s).")
+def study(name: str, out: str | None, quick: bool, pulse: str | None, pulse_start: float | None) -> None:
     """Run study NAME and write report.md, report.html, results.json and figures/ (NAME 'list': list them)."""
     from .studies.registry import all_studies, get_study
 
@@ -434,7 +438,11 @@ def study(name: str, out: str | None, quick: bool) -> None:
         spec = get_study(name)
     except KeyError as e:
         raise BadInput(str(e.args[0])) from None
-    report = spec.run(Path(out) if out else Path("studies") / name, quick=quick, progress=True)
+    options = {k: v for k, v in (("pulse", pulse), ("pulse_start", pulse_start)) if v is not None}
+    for k in options:
+        if k not in spec.options:
+            raise BadInput(f"--{k.replace('_', '-')}: not an option of study {name!r}")
+    report = spec.run(Path(out) if out else Path("studies") / name, quick=quick, progress=True, **options)
     html = report.with_suffix(".html")
     click.echo(f"report: {report}" + (f", {html}" if html.exists() else ""))
 

@@ -84,7 +84,7 @@ def main(out: str, given: str | None) -> None:
             ts, Xs = inp["ts"], inp["Xs"]
     nxc = prep.controller.x0.size
     status = np.zeros(N_POINTS, dtype=np.int64)
-    taus, dXs, auxs = np.zeros((N_POINTS, 3)), np.zeros((N_POINTS, nxc)), np.zeros((N_POINTS, 18))
+    taus, dXs, auxs = np.zeros((N_POINTS, 3)), np.zeros((N_POINTS, nxc)), np.zeros((N_POINTS, len(fxtntsmc.AUX_NAMES)))
     # the attitude by NumPy, the same numbers in both processes (the law's own functions differ)
     atts = np.stack([np.cos(Xs[:, 3]), np.sin(Xs[:, 3]), np.cos(Xs[:, 4]), np.sin(Xs[:, 4])], axis=1)
     _evaluate(ts, Xs, atts, prep.cp, prep.vp_nom, prep.ref_p, status, taus, dXs, auxs)

@@ -96,12 +96,26 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
     from report_check import check_html_report
 
     html = check_html_report(tmp_path, "summary.md")  # every figure embedded, the same report as summary.md
-    assert html.count('class="verdict ') == 6 and "virtual point" in html  # 3 claims x (paper, tuned gains)
+    from auvtrack.studies.reproduce import FORMS
+
+    # 3 claims x (paper gains, tuned gains, each form of the law)
+    assert html.count('class="verdict ') == 3 * (2 + len(FORMS)) and "virtual point" in html
     assert summary in (tmp_path / "summary.md").read_text()
     m = json.loads((tmp_path / "metrics.json").read_text())
     assert m["status"] == {"FXTNTSMC": "ok", "FTSMC": "ok"}
     assert {v["verdict"] for v in m["verdicts"]} <= {"supported", "not supported", "mixed"}
     assert len(m["verdicts"]) == 3 and "faster convergence" in summary
+    # every verdict states its conditions, and the paper's printed forms are judged too
+    assert m["conditions"]["estimator"].startswith("effective") and "xi0" in m["conditions"]["start"]
+    assert all(v["conditions"] for v in m["verdicts"]) and "Conditions of the FXTNTSMC" in summary
+    forms = {f["name"]: f for f in m["forms"]}
+    assert {"corrected", "printed_law34", "printed_surface28", "printed_baseline24", "printed_start"} <= set(forms)
+    assert forms["corrected"]["full_window"] == m["full_window"]["FXTNTSMC"]
+    assert forms["printed_law34"]["conditions"]["estimator"].startswith("law (34)")
+    assert forms["printed_start"]["status"] == "refused"
+    assert {v["verdict"] for v in forms["printed_start"]["verdicts"]} == {"not testable"}
+    assert forms["printed_baseline24"]["status"] == "failed"
+    assert {v["verdict"] for v in forms["printed_baseline24"]["verdicts"]} == {"not testable"}
     for kind in ("fxtntsmc", "ftsmc"):
         assert (tmp_path / kind / "trajectory.csv").exists() and (tmp_path / kind / "run.json").exists()
     # the fair-tuning comparison really runs the tuned gains (a preset next to written-out gains would not)

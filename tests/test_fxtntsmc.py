@@ -212,7 +212,7 @@ def test_setup_packs_the_precomputed_coefficients():
     assert p.cp[F.SC2] == pytest.approx((0.7 - 1) * 0.01 ** (0.7 - 2), rel=1e-15)
     assert p.cp[F.SB1] == pytest.approx((2 - 0.65) * 0.005 ** (0.65 - 1), rel=1e-15)
     assert p.cp[F.SB2] == pytest.approx((0.65 - 1) * 0.005 ** (0.65 - 2), rel=1e-15)
-    assert p.cp[F.EST] == 2 and p.cp[F.NEUR] == 7  # Section 4: omega-weighted law, 7 neurons
+    assert p.cp[F.EST] == 3 and p.cp[F.NEUR] == 7  # Section 4: effective-gain law (default), 7 neurons
 
 
 def test_ftsmc_sig_pair_matches_two_sig_calls():

@@ -96,12 +96,17 @@ ENGINE_V1 = _digests()
 @pytest.mark.parametrize("case", sorted((ENGINE_V1 or {"cases": {}})["cases"]))
 def test_5dof_trajectories_are_bit_identical_to_engine_v1(case):
     """Trajectories (every channel up to chi, as float64 bytes) equal those of the engine before plants
-    became pluggable (commit 2bbb533, tests/data/engine_v1_digests.json)."""
+    became pluggable (commit 2bbb533, tests/data/engine_v1_digests.json).
+
+    Run as engine v1 ran them: with its default estimator law (`omega`; the default is now
+    `effective`, which differs only where the risk monitor is in its band) and without the
+    channel added since (`gain_ratio_*`)."""
     rec = ENGINE_V1["cases"][case]
-    res = run_prepared(prepare(load_scenario({}, rec["overrides"])))
+    res = run_prepared(prepare(load_scenario({}, ["estimator.kind=omega", *rec["overrides"]])))
     assert res.status == rec["status"]
-    last = max(i for i, c in enumerate(res.names) if c.startswith("chi_"))
-    data = np.ascontiguousarray(np.column_stack([res[c] for c in list(res.names)[:last + 1]]))
+    names = [c for c in res.names if not c.startswith("gain_ratio_")]
+    last = max(i for i, c in enumerate(names) if c.startswith("chi_"))
+    data = np.ascontiguousarray(np.column_stack([res[c] for c in names[:last + 1]]))
     assert hashlib.sha256(data.tobytes()).hexdigest() == rec["data_sha256"]
 
 

@@ -38,7 +38,7 @@ def assert_section4(sc: Scenario) -> None:
     assert (e.delta, e.epsilon, e.lambda1, e.lambda2, e.lambda3) == (2.0, 0.1, 0.5, 0.3, 0.1)
     assert e.widen_start is True and 0 < e.xi0 < 1  # ERRATA 9
     est = sc.estimator
-    assert (est.kind, est.neurons, est.width) == ("omega", 7, 1.0)
+    assert (est.kind, est.neurons, est.width) == ("effective", 7, 1.0)
     assert est.centre_range == (-1.0, 1.0) and est.weight_range == (0.0, 1.0)
     assert sc.disturbance == [{"kind": "paper", "amplitude": 1.0, "phase": 0.0}]
     assert sc.metrics.window == (0.0, math.inf)

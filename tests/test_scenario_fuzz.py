@@ -328,7 +328,7 @@ def controllers(draw):
 def estimators(draw):
     lo = draw(st.floats(-10, 10))
     wlo = draw(st.floats(-10, 10))
-    return {"kind": draw(st.sampled_from(["none", "printed", "omega"])),
+    return {"kind": draw(st.sampled_from(["none", "printed", "omega", "effective"])),
             "neurons": draw(st.integers(1, 50)), "width": draw(pos(100)),
             "centre_range": [lo, lo + draw(pos(10))], "weight_range": [wlo, wlo + draw(st.floats(0, 10))]}
 

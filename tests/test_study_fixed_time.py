@@ -100,3 +100,44 @@ def test_quick_fixed_time_end_to_end(quick_run):
     a = data["analysis"]["matched"]
     assert set(a) == set(st.controllers)
     assert all(sum(v["failures_by_cause"].values()) == v["runs"] - v["ok"] for v in a.values())
+    # the verdict is computed from the stored numbers and says what was not shown
+    vd = data["verdict"]
+    assert vd["verdict"] in ("not demonstrated", "consistent with a fixed-time bound (not a proof)")
+    assert vd["not_shown"] and "## Verdict" in text
+    assert vd == fixed_time.verdict(data, st.starts[0])
+
+
+def test_zero_weight_variant_starts_the_network_at_zero():
+    from auvtrack.simulation.api import prepare
+
+    st = Settings(duration=1.0)
+    p0 = prepare(initial_scenario("fxtntsmc-w0", (0.1, 0.0, 0.0), st))
+    p1 = prepare(initial_scenario("fxtntsmc", (0.1, 0.0, 0.0), st))
+    w0, w1 = np.array(p0.resolved["controller"]["rbf_weights0"]), np.array(p1.resolved["controller"]["rbf_weights0"])
+    assert w0.shape == w1.shape and np.all(w0 == 0) and np.all(w1 > 0)
+    assert p0.resolved["controller"]["rbf_centres"] == p1.resolved["controller"]["rbf_centres"]  # same network
+
+
+def _rows(curve, kind="k"):
+    return [{"controller": kind, "status": "ok", "e0": m, "settle_1cm": v} for m, v in curve]
+
+
+def test_slopes_over_all_magnitudes_and_by_decade_are_least_squares_in_log_log():
+    mags = list(magnitude_grid(1e-2, 1e1, 2))
+    # t = 3 |e0|^0.5 below 0.1 m, constant above: slope 0.5 on the first decade, 0 on the last
+    curve = [(m, 3 * min(m, 0.1) ** 0.5) for m in mags]
+    rows = _rows(curve)
+    dec = fixed_time._decade_slopes(rows, "settle_1cm", mags)
+    assert [d["from"] for d in dec] == pytest.approx(mags[:len(dec)]) and dec[-1]["to"] == pytest.approx(10.0)
+    assert dec[0]["slope"] == pytest.approx(0.5, abs=1e-12) and dec[-1]["slope"] == pytest.approx(0.0, abs=1e-12)
+    x, y = np.log([c[0] for c in curve]), np.log([c[1] for c in curve])
+    assert fixed_time._slope(rows, "settle_1cm", mags[0]) == pytest.approx(np.polyfit(x, y, 1)[0], rel=1e-12)
+
+
+def test_monotonicity_reports_each_decrease_with_the_completed_directions():
+    per_mag = {0.1: 5.0, 1.0: 4.0, 10.0: 6.0, 31.6: None}
+    mono = fixed_time._monotone(per_mag, {0.1: 0, 1.0: 2, 10.0: 0, 31.6: 5}, 5)
+    assert mono["nondecreasing"] is False
+    assert mono["decreases"] == [{"from": 0.1, "to": 1.0, "settle_from": 5.0, "settle_to": 4.0,
+                                  "completed_from": 5, "completed_to": 3, "directions": 5}]
+    assert fixed_time._monotone({0.1: 1.0, 1.0: 1.0, 10.0: 2.0}, {0.1: 0, 1.0: 0, 10.0: 0}, 5)["nondecreasing"]

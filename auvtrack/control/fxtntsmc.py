@@ -7,20 +7,22 @@ Per axis i, with z the transformed error of eq. (17) and the envelope of
     S1  = sig^alpha(S_e) if |S_e| > sigma, else beta1 S_e + beta2 sign(S_e) S_e^2   (eq. 27)
     nu  = -kappa1 sign S - kappa2 sig^3 S - kappa3 S                            (reaching law)
 
-The input makes S_dot = nu + Omega (chi - chi_hat) (ERRATA 13, derivation in
-docs/derivation.md): from z_ddot = Omega_dot e_dot + Omega e_ddot - U_dot e - U e_dot,
+The input makes S_dot = nu + G (chi - chi_hat) (ERRATA 13, derivation in docs/derivation.md):
+from z_ddot = Omega_dot e_dot + Omega e_ddot - U_dot e - U e_dot with U_dot e = c0 + c1 e_ddot,
 
-    e_ddot* = [nu - S1_dot - Omega_dot e_dot + U_dot e + U e_dot] / Omega     (Omega^-1 on nu)
+    e_ddot* = [nu - S1_dot - Omega_dot e_dot + c0 + U e_dot] / G,  G = Omega - c1   (G^-1 on nu)
     tau_bar = M_bar J3^-1 (e_ddot* - chi_hat - J3_dot v1 - J4_dot + eta_d_ddot) + C_bar v1 + D_bar v1 + G_bar
 
-where U_dot contains e_ddot itself (loop 2 of ERRATA 10), solved in closed form.
+where U_dot contains e_ddot itself (loop 2 of ERRATA 10), solved in closed form; G is the
+effective gain (= Omega outside the band of the risk monitor's gamma, where c1 = 0).
 The |z|^(a2-1) of S1_dot (ERRATA 12) is handled by ``surface``: "nonsingular" replaces
 sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the same device as
 eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
 
 Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels per axis: rho (envelope),
-rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger)
-and zeta (z, the transformed error).
+rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger),
+zeta (z, the transformed error) and gain_ratio (G/Omega: the effective gain G = Omega - c1 with
+which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band).
 """
 from __future__ import annotations
 
@@ -40,7 +42,8 @@ from .tracking import error_state_forces, input_for_accel_forces, sign
 NAME = "fxtntsmc"
 AXES = ("x", "y", "z")
 # channel names (formerly S_* and z_*, still readable: auvtrack/simulation/channels.py)
-AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding", "g", "zeta") for a in AXES)
+AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding", "g", "zeta", "gain_ratio")
+                  for a in AXES)
 
 # Packed parameters cp (built by :func:`setup`):
 #   0-11   kappa1, kappa2, kappa3, a1, a2, a3, a4, alpha, sigma, surface code, z_switch, z_floor
@@ -235,17 +238,20 @@ def _transform(kind, shape, cp, eprm, e, ed, xc, i):
 def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux):
     """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27) and the commanded e_ddot (eq. 32, ERRATA 13).
 
-    Returns (S (m/s), e_ddot (m/s^2), Omega_i); writes dxc of rho_bar_i and the aux channels except
+    Returns (S (m/s), e_ddot (m/s^2), Omega_i, G_i), G_i = Omega_i - c1_i the effective gain with
+    which chi enters S_dot (1/m, as Omega); writes dxc of rho_bar_i and the aux channels except
     chi_hat, which the estimator's update of the three axes fills in afterwards.
     """
     _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
     s1, dphi = switch_q(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2], qs)
     S = zd + s1
     reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
-    edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / (Om - c1)
+    G = Om - c1  # > 0 (docs/derivation.md section 3)
+    edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / G
     dxc[RHO_BAR + i] = rbd
     aux[i], aux[3 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, S, g, z
-    return S, edd, Om
+    aux[18 + i] = G / Om  # exactly 1 where c1 = 0
+    return S, edd, Om, G
 
 
 @njit_noalloc(inline="always")
@@ -289,12 +295,16 @@ def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
     se2, dse2 = surface_q(z[2], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[2])
     ase = (abs(se0), abs(se1), abs(se2))
     qs = powers_below3(ase, cp[ALPHA], (ase[0] > cp[SIGMA], ase[1] > cp[SIGMA], ase[2] > cp[SIGMA]))
-    S0, edd0, om0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux)
-    S1, edd1, om1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux)
-    S2, edd2, om2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux)
+    S0, edd0, om0, G0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux)
+    S1, edd1, om1, G1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux)
+    S2, edd2, om2, G2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux)
     chat = (0.0, 0.0, 0.0)
     if est != rbf.NONE:
-        gain = (om0, om1, om2) if est == rbf.OMEGA else (1.0, 1.0, 1.0)
+        gain = (1.0, 1.0, 1.0)  # printed eq. (34)
+        if est == rbf.OMEGA:
+            gain = (om0, om1, om2)
+        elif est == rbf.EFFECTIVE:
+            gain = (G0, G1, G2)
         chat = rbf.estimate_and_adapt3(xc, WEIGHTS, m, work, (S0, S1, S2), gain, dxc)
     aux[6], aux[7], aux[8] = chat
     acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])

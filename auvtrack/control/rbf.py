@@ -2,14 +2,18 @@
 
 chi_hat_i = W_i^T psi(x),  psi_j(x) = exp(-||x - c_j||^2 / (2 b^2)),  x = [e, e_dot] in R^6,
 with m Gaussian neurons shared by the three axes and one weight vector W_i in R^m per axis.
-Adaptive laws (ERRATA 14):
+Adaptive laws (ERRATA 14, docs/derivation.md section 5):
 
-* ``printed`` (eq. 34 as printed):       W_i_dot = psi S_i - W_i (W_i^T W_i)
-* ``omega``   (Lyapunov-consistent):     W_i_dot = Omega_i psi S_i - W_i (W_i^T W_i)
+* ``printed``   (eq. 34 as printed):          W_i_dot = psi S_i - W_i (W_i^T W_i)
+* ``omega``     (Omega-weighted, ERRATA 14):  W_i_dot = Omega_i psi S_i - W_i (W_i^T W_i)
+* ``effective`` (Lyapunov-consistent):        W_i_dot = G_i psi S_i - W_i (W_i^T W_i)
 
-The Omega factor is what the Lyapunov argument of Theorem 1 needs, because chi enters
-S_dot multiplied by Omega (eq. 19).  Centres and initial weights are drawn from the scenario
-seed (stream "rbf") as in Section 4: centres uniform in [-1, 1], weights uniform in [0, 1].
+chi enters S_dot multiplied by the effective gain G_i = Omega_i - c1_i of the control law,
+S_i_dot = nu_i + G_i (chi_i - chi_hat_i) (c1_i = 0 outside the band of the risk monitor's
+gamma, where loop 2 of ERRATA 10 is active); only the G-weighted law cancels the cross term
+of Theorem 1's Lyapunov function everywhere.  ``omega`` equals ``effective`` outside the band.
+Centres and initial weights are drawn from the scenario seed (stream "rbf") as in Section 4:
+centres uniform in [-1, 1], weights uniform in [0, 1].
 """
 from __future__ import annotations
 
@@ -19,8 +23,8 @@ from .._jit import njit_noalloc
 from .._vecmath import exp8
 from .._seeding import rng
 
-NONE, PRINTED, OMEGA = 0, 1, 2
-ESTIMATORS = {"none": NONE, "printed": PRINTED, "omega": OMEGA}
+NONE, PRINTED, OMEGA, EFFECTIVE = 0, 1, 2, 3
+ESTIMATORS = {"none": NONE, "printed": PRINTED, "omega": OMEGA, "effective": EFFECTIVE}
 N_INPUT = 6
 
 
@@ -59,7 +63,8 @@ def basis(e, ed, cp, off, m, width, psi):
 def estimate_and_adapt(X, off, m, psi, S_i, gain, dX):
     """chi_hat_i = W^T psi (eq. 33, m/s^2) with W = X[off : off + m]; dX gets W_dot (eq. 34).
 
-    W_dot = gain psi S_i - W (W^T W), gain = 1 (printed law) or Omega_i (Omega-weighted law).
+    W_dot = gain psi S_i - W (W^T W), gain = 1 (printed law), Omega_i (Omega-weighted law) or
+    G_i = Omega_i - c1_i (the effective gain, Lyapunov-consistent law).
     """
     chat, w2 = 0.0, 0.0
     for j in range(m):

@@ -176,13 +176,11 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     dict
         ``{"kernels": [...], "compiled": [...], "seconds": wall time}``.
     """
-    from ..control import CONTROLLERS
     from ..plant import PLANTS
     from ..simulation import kernels
+    from ..simulation.api import kernel_keys
 
-    keys = [kernels.KernelKey(CONTROLLERS[c].module, module, f"{c} on {label}")
-            for c in (controllers or builtin_controllers()) for p in (plants or tuple(PLANTS))
-            for label, module in PLANTS[p].kernel_modules.items()]
+    keys = kernel_keys([(c, p) for c in (controllers or builtin_controllers()) for p in (plants or tuple(PLANTS))])
     t0 = time.perf_counter()
     done = kernels.warmup(keys, progress=progress)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],

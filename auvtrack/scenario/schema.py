@@ -407,7 +407,7 @@ class EnvelopeSection(_Section):
 class EstimatorSection(_Section):
     """``[estimator]``: RBF network estimating the lumped disturbance (eq. 11-13, 33-34)."""
 
-    kind: Literal["none", "printed", "omega"] = "omega"
+    kind: Literal["none", "printed", "omega", "effective"] = "effective"
     # the engine's upper limit (scratch size) is checked by auvtrack.control.fxtntsmc.setup
     neurons: Annotated[Int, Field(ge=1)] = 7
     width: Pos = Field(1.0, description="Gaussian width b")

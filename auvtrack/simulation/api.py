@@ -252,6 +252,49 @@ def ensure_compiled(preps: Sequence[Prepared], *, progress: bool = False) -> Non
     kernels.warmup([p.key for p in preps], progress=progress)
 
 
+def kernel_keys(pairs: Sequence[tuple[str, str]]) -> list[kernels.KernelKey]:
+    """The kernels of (controller kind, plant model) pairs: one per plant module.
+
+    A plant with presets in their own modules (``"6dof"``) gives one kernel per preset.
+
+    Parameters
+    ----------
+    pairs : sequence of (str, str)
+        Registered controller kinds and plant models, e.g. ``[("fxtntsmc", "5dof")]``.
+
+    Returns
+    -------
+    list of KernelKey
+        In the order of ``pairs``.
+    """
+    from ..control import CONTROLLERS
+    from ..plant import PLANTS
+
+    return [kernels.KernelKey(CONTROLLERS[c].module, module, f"{c} on {label}")
+            for c, p in pairs for label, module in PLANTS[p].kernel_modules.items()]
+
+
+def compile_first(pairs: Sequence[tuple[str, str]], *, progress: bool = False) -> list[kernels.KernelKey]:
+    """Compile (or load) the kernels a piece of work needs before it starts its own progress bars.
+
+    Studies and ``reproduce`` call this first, so that a first run shows its "compiling kernels
+    (first run only, about N s)" step, with its own progress bar, before the work's bar.
+
+    Parameters
+    ----------
+    pairs : sequence of (str, str)
+        (controller kind, plant model) pairs, see :func:`kernel_keys`.
+    progress : bool, optional
+        Show a progress bar over the kernels being compiled.
+
+    Returns
+    -------
+    list of KernelKey
+        The kernels compiled now (empty when every one was cached).
+    """
+    return kernels.warmup(kernel_keys(pairs), progress=progress)
+
+
 def call_kernel(prep: Prepared, out: Outputs) -> tuple[int, int, float]:
     """Run the kernel of ``prep`` into ``out``; return (cause, rows logged, stop time)."""
     run = kernels.kernel(prep.key)

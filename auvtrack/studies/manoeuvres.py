@@ -156,9 +156,10 @@ def run(out, *, quick: bool = False, progress: bool = False):
     from matplotlib.figure import Figure
 
     from ..scenario import load_scenario
-    from ..simulation.api import prepare, run_prepared
+    from ..simulation.api import compile_first, prepare, run_prepared
     from .report import Report, write_json
 
+    compile_first([("open_loop_actuators", "6dof")], progress=progress)
     out = Path(out)
     runs, rows = {}, []
     for which in SCENARIOS:

@@ -156,8 +156,9 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
         The report's path.
     """
     from ..scenario import load_scenario
-    from ..simulation.api import prepare, run_prepared
+    from ..simulation.api import compile_first, prepare, run_prepared
 
+    compile_first([(c, p) for c in controllers() for p in ("5dof", "6dof")], progress=progress)
     out = Path(out)
     duration = 20.0 if quick else 150.0
     rows = []

@@ -35,6 +35,7 @@ from matplotlib.figure import Figure
 from tqdm.auto import tqdm
 
 from ..runner.batch import iter_batch
+from ..simulation.api import compile_first
 from .registry import StudySpec
 from .report import Report, failure_cause, write_json
 
@@ -176,6 +177,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     duration = 10.0 if quick else 40.0
     factors = tuple(replace(f, levels=(f.levels[0], f.levels[-1])) for f in FACTORS) if quick else FACTORS
     todo = jobs(duration, factors)
+    compile_first([(k, "5dof") for k in CONTROLLERS], progress=progress)
     runs = iter_batch(todo, _prepare, block=16)  # metrics only, parallel over the cores
     rows = [_row(job, res) for job, res in tqdm(runs, total=len(todo), disable=not progress, desc="realism")]
     write_json(out / "results.json", {"duration_s": duration, "rows": rows})

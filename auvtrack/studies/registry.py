@@ -11,7 +11,7 @@ import importlib
 import pkgutil
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Protocol
+from typing import Callable, Iterable, Protocol
 
 
 class StudyRunner(Protocol):
@@ -33,11 +33,32 @@ class StudySpec:
         ``run(out, *, quick=False, progress=False) -> Path`` (see :class:`StudyRunner`).
     summary : str
         One line shown by ``auvtrack study --help``.
+    options : tuple of str
+        Keyword options of ``run`` beyond ``quick`` and ``progress`` that the command line may
+        pass (e.g. ``("pulse", "pulse_start")`` for ``--pulse``, ``--pulse-start``).
     """
 
     name: str
     run: Callable[..., Path]
     summary: str = ""
+    options: tuple[str, ...] = ()
+
+
+def kinds_in(overrides: Iterable[str]) -> list[str]:
+    """The controller kinds that ``controller.kind=...`` overrides name (for :func:`~auvtrack.simulation.api.compile_first`).
+
+    Parameters
+    ----------
+    overrides : iterable of str
+        ``--set``-style overrides.
+
+    Returns
+    -------
+    list of str
+        Every kind named, in order, without repeats.
+    """
+    kinds = [o.split("=", 1)[1].strip() for o in overrides if o.replace(" ", "").startswith("controller.kind=")]
+    return list(dict.fromkeys(kinds))
 
 
 def all_studies() -> dict[str, StudySpec]:

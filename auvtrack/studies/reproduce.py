@@ -5,20 +5,28 @@ run folder for each, the paper's Figures 3-8 (PNG and PDF), a metrics table (Mar
 JSON) and a verdict on each of the paper's three claims computed from the measured numbers;
 ``summary.md`` and the self-contained ``report.html`` hold the same report
 (:class:`~auvtrack.studies.report.Report`).
+
+Every verdict states its conditions (estimator law, sliding surface, start treatment, envelope
+baseline, gains; :func:`conditions`).  Besides the corrected defaults the claims are judged for
+each of the paper's printed forms (:data:`FORMS`): the adaptive law (34), the surface (28), both,
+the baseline (24) and the untreated start, which are reported as not testable where the
+FXTNTSMC cannot complete the run.
 """
 from __future__ import annotations
 
 import json
 import math
+import warnings
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from ..control.fxtntsmc import StartOutsideEnvelope
 from ..control.params import get_gain_preset
 from ..simulation import plotting
-from ..simulation.api import prepare, run_prepared
+from ..simulation.api import compile_first, prepare, run_prepared
 from ..simulation.result import Result
 from ..scenario import load_scenario
 from ..scenario import paper_scenario_path
@@ -56,13 +64,61 @@ CAPTIONS = {
 }
 
 
+FORMS = (
+    ("corrected", "corrected forms (the defaults)", ()),
+    ("omega", "Omega-weighted adaptive law (ERRATA 14)", ("estimator.kind=omega",)),
+    ("printed_law34", "adaptive law (34) as printed", ("estimator.kind=printed",)),
+    ("printed_surface28", "surface (28) as printed", ("controller.surface=printed",)),
+    ("printed_law34_surface28", "law (34) and surface (28) as printed",
+     ("estimator.kind=printed", "controller.surface=printed")),
+    ("printed_baseline24", "envelope baseline (24) as printed", ("envelope.baseline=printed",)),
+    ("printed_start", "Section 4's start without treatment", ("envelope.widen_start=false",)),
+)
+"""Forms of the FXTNTSMC whose verdicts ``reproduce`` reports: (name, label, overrides)."""
+CLAIMS = ("faster convergence", "higher accuracy", "less chattering")
+
+
 @dataclass
 class Verdict:
     """One claim of the paper, tested on measured numbers."""
 
     claim: str
-    verdict: str  # "supported", "not supported" or "mixed"
+    verdict: str  # "supported", "not supported", "mixed" or "not testable"
     evidence: str
+    conditions: str = ""
+
+
+def conditions(scenario, gains: str = "paper (Section 4)", notes: tuple[str, ...] = ()) -> dict[str, str]:
+    """The conditions a FXTNTSMC verdict holds under, read from its scenario.
+
+    Returns
+    -------
+    dict
+        ``estimator``, ``surface``, ``start``, ``baseline`` and ``gains`` as short text.
+    """
+    env, ctl = scenario.envelope, scenario.controller
+    widened = [n for n in notes if "widened" in n]
+    if not env.widen_start:
+        start = "as printed (no treatment)"
+    elif widened:
+        start = f"widened to |e|/rho = xi0 = {env.xi0:g} (ERRATA 9)"
+    else:
+        start = "inside the envelope (no treatment needed)"
+    return {
+        "estimator": {"effective": "effective-gain law (G = Omega - c1, Lyapunov-consistent)",
+                      "omega": "Omega-weighted law (ERRATA 14)", "printed": "law (34) as printed",
+                      "none": "no estimator"}[scenario.estimator.kind],
+        "surface": ("nonsingular (C1 switch on |z|)" if ctl.surface == "nonsingular"
+                    else f"(28) as printed, |z| floored at {ctl.z_floor:g}"),
+        "start": start,
+        "baseline": "corrected (24)" if env.baseline == "corrected" else "(24) as printed",
+        "gains": gains,
+    }
+
+
+def conditions_text(c: dict[str, str]) -> str:
+    """One line: ``estimator ...; surface ...; start ...; baseline ...; gains ...``."""
+    return "; ".join(f"{k} {v}" for k, v in c.items())
 
 
 def _run(kind: str, overrides: list[str], window: tuple[float, float]) -> tuple[Result, Result]:
@@ -106,16 +162,82 @@ def _fmt(x) -> str:
     return "inf" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.4g}"
 
 
-def verdicts(full: dict[str, dict], steady: dict[str, dict], window: tuple[float, float]) -> list[Verdict]:
-    """The paper's three claims judged on the measured metrics (lower is better throughout)."""
+def verdicts(full: dict[str, dict], steady: dict[str, dict], window: tuple[float, float],
+             cond: str = "") -> list[Verdict]:
+    """The paper's three claims judged on the measured metrics (lower is better throughout).
+
+    ``cond`` (:func:`conditions_text`) is attached to every verdict.
+    """
     a, b = full["FXTNTSMC"], full["FTSMC"]
     sa, sb = steady["FXTNTSMC"], steady["FTSMC"]
-    return [
+    vs = [
         _compare("faster convergence (time for |e| to stay below 1 cm)", "settle_1cm", AXES, a, b, "s"),
         _compare(f"higher accuracy (steady-state RMSE, t in [{window[0]:g}, {window[1]:g}] s)", "rmse", AXES, sa, sb, "m"),
         _compare(f"less chattering (total variation of tau per second, t in [{window[0]:g}, {window[1]:g}] s)",
                  "tv_tau", INPUTS, sa, sb, "N/s or N m/s"),
     ]
+    for v in vs:
+        v.conditions = cond
+    return vs
+
+
+def _not_testable(why: str, cond: str) -> list[Verdict]:
+    return [Verdict(c, "not testable", why, cond) for c in CLAIMS]
+
+
+def form_verdicts(overrides: list[str], ftsmc: tuple[dict, dict], window: tuple[float, float],
+                  done: dict[str, tuple[Result, Result]] | None = None) -> list[dict]:
+    """Verdicts for every form of :data:`FORMS` against the FTSMC run ``ftsmc`` = (full, steady) metrics.
+
+    ``done`` maps a form's name to its (full, steady) runs when they were made already (the
+    corrected form is ``reproduce``'s main FXTNTSMC run); the others are run here.
+
+    Returns
+    -------
+    list of dict
+        Per form: ``name``, ``label``, ``overrides``, ``conditions``, ``status``, ``failure``,
+        ``verdicts`` and the FXTNTSMC's ``full_window`` / ``steady_window`` metrics.
+    """
+    out = []
+    for name, label, extra in FORMS:
+        ov = [*overrides, *extra]
+        sc = load_scenario(paper_scenario_path(), ["controller.kind=fxtntsmc", *ov])
+        rec = {"name": name, "label": label, "overrides": list(extra), "failure": None,
+               "full_window": None, "steady_window": None}
+        try:
+            with warnings.catch_warnings():  # the start widening is stated in the conditions
+                warnings.simplefilter("ignore")
+                full, steady = (done or {}).get(name) or _run("fxtntsmc", ov, window)
+        except StartOutsideEnvelope as e:
+            cond = conditions(sc)
+            rec.update(conditions=cond, status="refused", failure={"cause": "start_refused", "detail": str(e)},
+                       verdicts=[v.__dict__ for v in _not_testable(f"the run is refused: {e}", conditions_text(cond))])
+            out.append(rec)
+            continue
+        cond = conditions(sc, notes=tuple(full.meta.get("notes", ())))
+        rec.update(conditions=cond, status=full.status, failure=full.failure,
+                   full_window=_jsonable({"m": full.metrics})["m"], steady_window=_jsonable({"m": steady.metrics})["m"])
+        if full.ok:
+            vs = verdicts({"FXTNTSMC": full.metrics, "FTSMC": ftsmc[0]}, {"FXTNTSMC": steady.metrics, "FTSMC": ftsmc[1]},
+                          window, conditions_text(cond))
+        else:
+            f = full.failure
+            vs = _not_testable(f"the FXTNTSMC run fails at t = {f['time']:.4g} s ({f['cause']}: {f['detail']})",
+                               conditions_text(cond))
+        rec["verdicts"] = [v.__dict__ for v in vs]
+        out.append(rec)
+    return out
+
+
+def _forms_report(rep: Report, forms: list[dict]) -> None:
+    """The verdicts for each form of the law (:data:`FORMS`), with conditions and evidence."""
+    rep.heading("The claims under each form of the FXTNTSMC")
+    rep.paragraph("The FTSMC run is the same throughout (default gains); each row changes the FXTNTSMC only as named.")
+    rep.table(["form", "status", *CLAIMS], [[f["label"], f["status"], *(v["verdict"] for v in f["verdicts"])]
+                                            for f in forms])
+    for f in forms:
+        rep.paragraph(f"**{f['label']}** ({conditions_text(f['conditions'])}): status **{f['status']}**")
+        rep.verdicts([(v["claim"], v["verdict"], v["evidence"]) for v in f["verdicts"]])
 
 
 def _table_rows(full: dict[str, dict], steady: dict[str, dict], window: tuple[float, float]) -> list[list[str]]:
@@ -151,14 +273,16 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     out.mkdir(parents=True, exist_ok=True)
     overrides = ["sim.duration=20"] if quick else []
     window = (10.0, 20.0) if quick else (50.0, 100.0)  # steady state: accuracy and chattering claims
+    compile_first([(kind, "5dof") for _, kind in CONTROLLERS], progress=progress)
     bar = tqdm(total=2 * len(CONTROLLERS) + len(FIGURES), disable=not progress, desc="reproduce", unit="step")
-    runs, full, steady = {}, {}, {}
+    runs, full, steady, steady_runs = {}, {}, {}, {}
     tuned, tuned_full, tuned_steady = {}, {}, {}
     for label, kind in CONTROLLERS:
         bar.set_postfix_str(kind)
         res, res_ss = _run(kind, overrides, window)
         res.save(out / kind, mat=True)
         runs[label], full[label], steady[label] = res, res.metrics, res_ss.metrics
+        steady_runs[label] = res_ss
         bar.update()
         bar.set_postfix_str(TUNED_PRESETS[kind])
         res, res_ss = _run(kind, [*overrides, *preset_overrides(TUNED_PRESETS[kind])], window)
@@ -173,10 +297,17 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
             bar.set_postfix_str(name)
             bar.update()
     bar.close()
-    vs = verdicts(full, steady, window)
-    vs_tuned = verdicts(tuned_full, tuned_steady, window)
+    sc_default = load_scenario(paper_scenario_path(), ["controller.kind=fxtntsmc", *overrides])
+    cond = conditions(sc_default, notes=tuple(runs["FXTNTSMC"].meta.get("notes", ())))
+    cond_tuned = conditions(sc_default, gains=f"tuned presets {', '.join(TUNED_PRESETS.values())}",
+                            notes=tuple(tuned["FXTNTSMC"].meta.get("notes", ())))
+    vs = verdicts(full, steady, window, conditions_text(cond))
+    vs_tuned = verdicts(tuned_full, tuned_steady, window, conditions_text(cond_tuned))
+    forms = form_verdicts(overrides, (full["FTSMC"], steady["FTSMC"]), window,
+                          done={"corrected": (runs["FXTNTSMC"], steady_runs["FXTNTSMC"])})
     rep = _report(out, runs, full, steady, vs, window)
     _tuned_report(rep, tuned, vs_tuned)
+    _forms_report(rep, forms)
     _figures(rep, runs, window)
     for label, r in runs.items():
         rep.scenario(_shown_scenario(r), f"Scenario of the {label} run (resolved; run folder `{r.scenario['controller']['kind']}/`)")
@@ -184,11 +315,12 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     (out / "metrics.json").write_text(json.dumps(
         {"full_window": _jsonable(full), "steady_window": {"window": list(window), **_jsonable(steady)},
          "status": {k: r.status for k, r in runs.items()},
-         "verdicts": [v.__dict__ for v in vs],
+         "conditions": cond, "verdicts": [v.__dict__ for v in vs],
          "tuned": {"presets": TUNED_PRESETS, "full_window": _jsonable(tuned_full),
                    "steady_window": {"window": list(window), **_jsonable(tuned_steady)},
                    "status": {k: r.status for k, r in tuned.items()},
-                   "verdicts": [v.__dict__ for v in vs_tuned]}}, indent=2))
+                   "conditions": cond_tuned, "verdicts": [v.__dict__ for v in vs_tuned]},
+         "forms": forms}, indent=2))
     return rep.text(closing=False)
 
 
@@ -219,6 +351,7 @@ def _tuned_report(rep: Report, runs: dict[str, Result], vs: list[Verdict]) -> No
                   f"(gain presets {', '.join(f'`{p}`' for p in TUNED_PRESETS.values())}; docs/tuning.md). "
                   "Run folders: `tuned/`.")
     rep.bullets(_status_lines(runs, " (tuned)"))
+    rep.paragraph(f"Conditions of the FXTNTSMC: {vs[0].conditions if vs else ''}.")
     rep.verdicts([(v.claim, v.verdict, v.evidence) for v in vs])
 
 
@@ -227,6 +360,8 @@ def _report(out: Path, runs, full, steady, vs, window) -> Report:
     notes = [f"note ({label}): {note}" for label, r in runs.items() for note in r.meta.get("notes", [])]
     rep.bullets(_status_lines(runs) + notes)
     rep.heading("The paper's claims")
+    rep.paragraph(f"Conditions of the FXTNTSMC: {vs[0].conditions if vs else ''}. The FTSMC: default gains. "
+                  "Other forms of the law: the section on each form below.")
     rep.verdicts([(v.claim, v.verdict, v.evidence) for v in vs])
     rep.heading("Metrics")
     rep.table(["metric", "window", "FXTNTSMC", "FTSMC"], _table_rows(full, steady, window))

@@ -28,7 +28,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..scenario import load_scenario
-from ..simulation.api import prepare
+from ..simulation.api import compile_first, prepare
 from ..runner.batch import run_batch
 from .registry import StudySpec
 from .report import Report, failure_cause, write_json
@@ -301,6 +301,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False,
     out.mkdir(parents=True, exist_ok=True)
     cfg = config or (QUICK if quick else FULL)
     samples = draw_samples(cfg.n, cfg.seed)
+    compile_first([(kind, "5dof") for _, kind, _ in CONTROLLERS], progress=progress)
     have = set(available_gain_presets())
     controllers = [c for c in CONTROLLERS if c[2] is None or c[2] in have]
     skipped = [c[0] for c in CONTROLLERS if c not in controllers]

@@ -37,7 +37,7 @@ from ..control import get as get_controller
 from ..control.params import FXTNTSMCParams
 from ..control.theory import check_theorem1
 from ..scenario import load_scenario
-from ..simulation.api import prepare, run_prepared
+from ..simulation.api import compile_first, prepare, run_prepared
 from .registry import StudySpec
 from .report import Report, write_json
 
@@ -576,6 +576,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     budget, objective = (QUICK if quick else FULL), Objective()
     say = print if progress else None
+    compile_first([(kind, "5dof") for kind in SPACES], progress=progress)
     results = {kind: tune(kind, budget, objective, progress=say) for kind in SPACES}
     heldout = HELDOUT_CASES[:1] if quick else HELDOUT_CASES
     train = TRAIN_CASES[: budget.n_train]
