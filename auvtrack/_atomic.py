@@ -175,8 +175,13 @@ def publish_folder(tmp: Path, final: Path, replaceable: Callable[[Path], str | N
         except OSError as exc:
             if exc.errno not in (errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR, errno.EISDIR):
                 raise
+        before = _identity(final)
+        if before is None:
+            continue  # another writer moved it aside meanwhile: try the rename again
         reason = replaceable(final)
         if reason is not None:
+            if _identity(final) != before:
+                continue  # moved or replaced by another writer while it was being checked: look again
             raise FolderError(f"{reason}; the complete output is kept in {tmp}")
         old = final.with_name(f".{final.name[:64]}.old-{uuid.uuid4().hex[:12]}")
         try:
@@ -191,3 +196,12 @@ def publish_folder(tmp: Path, final: Path, replaceable: Callable[[Path], str | N
         shutil.rmtree(old, ignore_errors=True)
     raise FolderError(f"{final}: could not be replaced after {attempts} attempts (other writers); "
                       f"the complete output is kept in {tmp}")
+
+
+def _identity(path: Path) -> tuple[int, int] | None:
+    """(device, inode) of ``path`` itself (a link is not followed), or None when nothing is there."""
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return None
+    return st.st_dev, st.st_ino

@@ -9,19 +9,27 @@ override the root.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
+import types as pytypes
 from pathlib import Path
 
 import numba
+from numba.core import errors, types
+from numba.core.registry import CPUDispatcher
 
-from . import _vecmath
+from . import _lanes, _vecmath  # noqa: F401  (_lanes: lane types registered before anything compiles)
 
 _PKG = Path(__file__).resolve().parent
 
 
+@functools.lru_cache(maxsize=None)
 def source_hash() -> str:
-    """Return a SHA-256 digest of every ``*.py`` file of the package (paths and contents)."""
+    """Return a SHA-256 digest of every ``*.py`` file of the package (paths and contents).
+
+    Computed once per process (Numba does not reload edited sources in a running process either).
+    """
     h = hashlib.sha256()
     for path in sorted(_PKG.rglob("*.py")):
         h.update(str(path.relative_to(_PKG)).encode())
@@ -36,13 +44,55 @@ def cache_dir() -> Path:
 
 
 numba.config.CACHE_DIR = str(cache_dir())
+LLVM_INLINE = os.environ.get("AUVTRACK_LLVM_INLINE", "1") != "0"
+
+
+class PlainArgsDispatcher(CPUDispatcher):
+    """A CPU dispatcher that compiles a call from compiled code for the non-literal argument types.
+
+    Numba types a constant argument as a literal (``Literal[int](0)``, ``Literal[bool](True)``)
+    and compiles the callee once per literal value: ``stage(..., True)`` and
+    ``stage(..., not reuse)`` were two compilations of the whole stage with the law inlined, a
+    counter starting at 0 another copy of ``log_row``, ``axis_baseline(..., i)`` three
+    (``benchmarks/profile.md``).  This dispatcher compiles the plain types (``int64``, ``bool``)
+    instead, once; a callee that only types with a literal (e.g. indexing a heterogeneous tuple
+    by it) still gets its literal specialisation.  Functions inlined by Numba
+    (``inline="always"``) are not dispatcher calls and keep seeing literals.
+    """
+
+    def get_call_template(self, args, kws):
+        """Resolve a call for the unliteral argument types (falling back to the literal ones)."""
+        plain = tuple(types.unliteral(a) for a in args)
+        plain_kws = {k: types.unliteral(v) for k, v in kws.items()}
+        if plain != tuple(args) or plain_kws != kws:
+            try:
+                return super().get_call_template(plain, plain_kws)
+            except errors.TypingError:
+                pass
+        return super().get_call_template(args, kws)
+
+
+def _plain(disp):
+    if isinstance(disp, CPUDispatcher) and type(disp) is CPUDispatcher:
+        disp.__class__ = PlainArgsDispatcher
+    return disp
 
 
 def njit(*args, **kwargs):
-    """``numba.njit`` with the project's defaults: on-disk cache, NumPy error model (1/0 -> inf)."""
+    """``numba.njit`` with the project's defaults: on-disk cache, NumPy error model (1/0 -> inf).
+
+    Calls from compiled code compile the callee for plain (non-literal) argument types
+    (:class:`PlainArgsDispatcher`).
+    """
     kwargs.setdefault("cache", True)
     kwargs.setdefault("error_model", "numpy")
-    return numba.njit(*args, **kwargs)
+    if kwargs.get("inline") == "always" and LLVM_INLINE:
+        kwargs.pop("inline")
+        kwargs["forceinline"] = True
+    out = numba.njit(*args, **kwargs)
+    if args and callable(args[0]):
+        return _plain(out)
+    return lambda fn: _plain(out(fn))
 
 
 def njit_noalloc(*args, **kwargs):
@@ -57,3 +107,43 @@ def njit_noalloc(*args, **kwargs):
     """
     kwargs["_nrt"] = False
     return njit(*args, **kwargs)
+
+
+_LLVM_INLINE: dict = {}
+
+
+def llvm_inline(disp):
+    """A copy of the compiled function ``disp`` that LLVM, not Numba, inlines into its callers.
+
+    ``inline="always"`` makes Numba copy a function's typed IR into every caller, and type and
+    lower each copy again; for a law of a few hundred lines inlined into two callers that was most
+    of a kernel's compile time (``benchmarks/profile.md``).  The copy returned here is compiled once
+    (``inline="never"``) and marked ``alwaysinline`` for LLVM (Numba's ``forceinline``), so each
+    caller still gets the law's code in its own body, from one compilation.  Same operations,
+    same numbers.  The copy is a distinct function (its own qualified name, hence its own cache
+    files: Numba's cache key does not include the compile options) and is made once per process.
+
+    Parameters
+    ----------
+    disp : numba dispatcher
+        A function compiled with :func:`njit` or :func:`njit_noalloc`.
+
+    Returns
+    -------
+    numba dispatcher
+        The LLVM-inlined copy.
+    """
+    got = _LLVM_INLINE.get(disp)
+    if got is not None:
+        return got
+    fn = disp.py_func
+    copy = pytypes.FunctionType(fn.__code__, fn.__globals__, fn.__name__, fn.__defaults__, fn.__closure__)
+    copy.__qualname__ = fn.__qualname__ + "__llvm_inline"
+    copy.__module__ = fn.__module__
+    copy.__doc__ = fn.__doc__
+    options = {k: v for k, v in disp.targetoptions.items() if k not in ("inline", "nopython", "boundscheck")}
+    options.pop("cache", None)
+    options["forceinline"] = True
+    out = njit(**options)(copy)
+    _LLVM_INLINE[disp] = out
+    return out

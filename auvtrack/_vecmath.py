@@ -67,6 +67,95 @@ def backend() -> str:
 BACKEND = backend()
 
 
+def _lane_signature(width: int, args) -> types.Type | None:
+    """Signature of a vector call on tuples whose entries are lane values (:mod:`auvtrack._lanes`).
+
+    Each of the ``width`` entries of each argument may be a float or lanes (L runs); the result has
+    lanes in every entry.  Returns None when no argument holds lanes (the scalar signature applies).
+    """
+    from ._lanes import Lanes
+
+    counts = set()
+    for a in args:
+        if not (isinstance(a, types.BaseTuple) and len(a) == width):
+            return None
+        for t in a.types:
+            if isinstance(t, Lanes):
+                if t.dtype != types.float64:
+                    return None
+                counts.add(t.count)
+            elif not isinstance(t, (types.Float, types.Integer)):
+                return None
+    if len(counts) != 1:
+        return None
+    L = counts.pop()
+    if L % 4:
+        return None
+    return types.UniTuple(Lanes(types.float64, L), width)(*args)
+
+
+WIDE_PAIRS = {"_ZGVdN4vv_pow": "_ZGVeN8vv_pow", "_ZGVdN4v_exp": "_ZGVeN8v_exp", "_ZGVdN4v_sin": "_ZGVeN8v_sin",
+              "_ZGVdN4v_cos": "_ZGVeN8v_cos"}
+"""4-lane AVX2 libmvec functions and their 8-lane AVX-512 forms that return the same bits (glibc 2.36,
+``tests/test_vecmath.py`` on 10^5 inputs each, specials included); the 8-lane ``atanh`` does not, so
+it is not here.  Used by lane kernels of 8 runs (:mod:`auvtrack._lanes`): one call per 8 runs."""
+
+
+def _wide() -> dict[str, str]:
+    if BACKEND != "avx2" or os.environ.get("AUVTRACK_LIBMVEC_AVX512", "1") == "0":
+        return {}
+    import llvmlite.binding as ll
+
+    if not ll.get_host_cpu_features().get("avx512f", False):
+        return {}
+    handle = ctypes.CDLL(ctypes.util.find_library("mvec"))
+    return {k: v for k, v in WIDE_PAIRS.items() if hasattr(handle, v)}
+
+
+WIDE = _wide()
+"""The pairs of :data:`WIDE_PAIRS` this machine can use (empty: no AVX-512, or libmvec lacks them)."""
+
+
+def _lane_call(name: str, width: int):
+    """Codegen of :func:`_vector_call` on lane values: entry k of every argument is one vector of L runs,
+    evaluated 4 runs per call of ``name`` (the same 4-lane function, so each run gets the value it
+    gets in a single run).  The calls are declared without side effects, so an entry whose result
+    is unused (the padding of ``(x, y, z, 1.0)``) is removed by LLVM."""
+    from llvmlite import ir
+
+    from ._lanes import Lanes, _splat
+
+    def codegen(context, builder, signature, args):
+        rty = signature.return_type.types[0]
+        L = rty.count
+        wide = WIDE.get(name) if L % 8 == 0 else None
+        w = 8 if wide else 4
+        vw = ir.VectorType(ir.DoubleType(), w)
+        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(vw, [vw] * len(args)), wide or name)
+        fn.attributes.add("nounwind")
+        fn.attributes.add("readnone")
+        outs = []
+        for k in range(width):
+            vecs = [_splat(context, builder, builder.extract_value(a, k), aty.types[k], Lanes(types.float64, L))
+                    for a, aty in zip(args, signature.args)]
+            res = None
+            for c in range(L // w):
+                idx = ir.Constant(ir.VectorType(ir.IntType(32), w), list(range(w * c, w * c + w)))
+                r = builder.call(fn, [builder.shuffle_vector(v, v, idx) for v in vecs])
+                if res is None:
+                    res = r
+                else:  # concatenate: [res, r] (res covers w c lanes)
+                    n = w * c
+                    r_wide = builder.shuffle_vector(r, r, ir.Constant(ir.VectorType(ir.IntType(32), n),
+                                                                         [i % w for i in range(n)]))
+                    res = builder.shuffle_vector(res, r_wide, ir.Constant(ir.VectorType(ir.IntType(32), n + w),
+                                                                             list(range(n)) + list(range(n, n + w))))
+            outs.append(res)
+        return context.make_tuple(builder, signature.return_type, outs)
+
+    return codegen
+
+
 def _vector_call(name: str, width: int, nargs: int, parts: int = 1):
     """Codegen calling the vector-ABI function ``name`` on ``nargs`` tuples of ``width`` floats.
 
@@ -95,30 +184,40 @@ def _vector_call(name: str, width: int, nargs: int, parts: int = 1):
     return codegen
 
 
-# libmvec, AVX2 vector ABI: one call per 4 lanes
+# libmvec, AVX2 vector ABI: one call per 4 lanes.  With lane values (several runs at once,
+# auvtrack._lanes) each entry of the tuple is a vector of runs, 4 runs per call (_lane_call).
+def _typed(name: str, width: int, sig, parts: int = 1):
+    def typer(typingctx, *args):
+        lane_sig = _lane_signature(width, args)
+        if lane_sig is not None:
+            return lane_sig, _lane_call(name, width)
+        return sig, _vector_call(name, width, len(args), parts)
+    return typer
+
+
 @intrinsic
 def _pow4_libmvec(typingctx, x, p):
-    return F4(F4, F4), _vector_call("_ZGVdN4vv_pow", 4, 2)
+    return _typed("_ZGVdN4vv_pow", 4, F4(F4, F4))(typingctx, x, p)
 
 
 @intrinsic
 def _exp8_libmvec(typingctx, x):
-    return F8(F8), _vector_call("_ZGVdN4v_exp", 8, 1, parts=2)
+    return _typed("_ZGVdN4v_exp", 8, F8(F8), parts=2)(typingctx, x)
 
 
 @intrinsic
 def _sin4_libmvec(typingctx, x):
-    return F4(F4), _vector_call("_ZGVdN4v_sin", 4, 1)
+    return _typed("_ZGVdN4v_sin", 4, F4(F4))(typingctx, x)
 
 
 @intrinsic
 def _cos4_libmvec(typingctx, x):
-    return F4(F4), _vector_call("_ZGVdN4v_cos", 4, 1)
+    return _typed("_ZGVdN4v_cos", 4, F4(F4))(typingctx, x)
 
 
 @intrinsic
 def _atanh4_libmvec(typingctx, x):
-    return F4(F4), _vector_call("_ZGVdN4v_atanh", 4, 1)
+    return _typed("_ZGVdN4v_atanh", 4, F4(F4))(typingctx, x)
 
 
 @numba.njit(inline="always", _nrt=False, error_model="numpy")

@@ -210,7 +210,8 @@ def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, 
 @click.option("--repeat", default=7, show_default=True, help="Timed repetitions; the median is reported.")
 @click.option("--duration", default=20.0, show_default=True, help="Simulated seconds per repetition.")
 @click.option("--all", "run_all", is_flag=True,
-              help="Full suite: every controller, batch runs/s, sweep throughput on 1 and 2 Dask workers; "
+              help="Full suite: cold first run and cold warmup (empty cache), every controller, batch runs/s and "
+                   "efficiency per back end (simd included), sweep throughput on 1 and 2 Dask workers; "
                    "writes results.{json,md} to --out.")
 @click.option("--out", "bench_out", type=click.Path(file_okay=False), default=None,
               help="Folder for the --all results (default: a new folder under ~/.local/share/auvtrack/bench, "

@@ -57,7 +57,7 @@ def test_cases_cover_success_and_failure(singles):
     assert singles[6].failure["cause"] == "pitch_limit"
 
 
-@pytest.mark.parametrize("backend", ["serial", "threads", "prange"])
+@pytest.mark.parametrize("backend", ["serial", "threads", "prange", "simd"])
 def test_batch_equals_single_runs_bitwise(preps, singles, backend):
     out = run_batch(preps, backend=backend, workers=2)
     assert len(out) == len(preps)

@@ -1,6 +1,7 @@
 """Benchmark plumbing (what is reported, not how fast: speed lives in benchmarks/results.md)."""
 import json
 
+import pytest
 from click.testing import CliRunner
 
 from auvtrack.cli import cli
@@ -52,9 +53,27 @@ def test_batch_rows_cover_every_controller_and_back_end():
 
     rows = bench_batch(repeat=2, runs=3, duration=0.02)
     assert [(r["controller"], r["backend"]) for r in rows] == [
-        (k, b) for k in ("ftsmc", "fxtntsmc") for b in ("serial", "threads", "prange")]
+        (k, b) for k in ("ftsmc", "fxtntsmc") for b in ("serial", "threads", "simd", "prange")]
     for r in rows:
         assert r["runs"] == 3 and r["repeat"] == 2 and 0 < r["runs_per_s"] <= r["max_runs_per_s"]
+
+
+def test_batch_efficiency_is_throughput_relative_to_single_runs():
+    """A core running 10 s runs (10^4 steps) of 1 us per step does 100 runs/s: efficiency 1."""
+    from auvtrack.runner.sweep_bench import batch_efficiency
+
+    row = {"runs_per_s": 200.0, "cores": 2, "run_seconds": 10.0}
+    assert batch_efficiency(row, us_per_step=1.0) == pytest.approx(1.0)
+    assert batch_efficiency({**row, "runs_per_s": 500.0}, us_per_step=1.0) == pytest.approx(2.5)
+
+
+def test_cold_start_compiles_only_the_kernel_it_needs():
+    """The cold run is timed in a new process with an empty cache; it compiles the one kernel of the run."""
+    from auvtrack.runner.sweep_bench import bench_cold_start
+
+    doc = bench_cold_start(duration=0.01)
+    assert doc["kernels_compiled"] == ["k_fxtntsmc__five_dof"]
+    assert 0 < doc["compile_seconds"] < doc["seconds"]
 
 
 def test_bench_all_leaves_the_working_tree_unchanged(tmp_path):
@@ -82,3 +101,19 @@ def test_bench_all_leaves_the_working_tree_unchanged(tmp_path):
     assert {"single", "batch", "sweep"} <= set(doc) and (folder / "results.md").exists()
     assert f"written: {folder / 'results.json'}" in p.stdout
     assert "Traceback" not in p.stderr and "heartbeat" not in p.stderr, p.stderr[-3000:]
+
+
+def test_warmup_covers_every_builtin_controller_on_every_plant_it_runs_on():
+    """Warmup's default pairs: each built-in controller (the 6-DOF-only one on the 6-DOF plant only) on
+    every plant, which warmup expands to one kernel per preset module."""
+    from auvtrack.control import BUILTIN_NAMES
+    from auvtrack.plant import PLANTS
+    from auvtrack.runner.bench import SIXDOF_ONLY, builtin_pairs
+
+    pairs = builtin_pairs()
+    assert {c for c, _ in pairs} == set(BUILTIN_NAMES)
+    for c in BUILTIN_NAMES:
+        plants = {p for k, p in pairs if k == c}
+        assert plants == ({"6dof"} if c in SIXDOF_ONLY else set(PLANTS))
+    assert len(PLANTS["6dof"].kernel_modules) >= 2  # the preset modules: one kernel each
+    assert builtin_pairs(("ftsmc",), ("5dof",)) == [("ftsmc", "5dof")]

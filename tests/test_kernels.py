@@ -33,7 +33,7 @@ def test_every_kernel_part_is_copied_verbatim_under_its_decorator():
     for name, decorator in engine.KERNEL_PARTS.items():
         body = "\n".join(inspect.getsource(getattr(engine, name)).splitlines()[1:])
         assert f"@{decorator}\n{body}" in src
-    assert "law = law_module('auvtrack.control.ftsmc').control" in src
+    assert "law = llvm_inline(law_module('auvtrack.control.ftsmc').control)" in src
     assert "from auvtrack.plant import five_dof as plant" in src
 
 
@@ -42,7 +42,9 @@ def test_each_pair_has_its_own_kernel_and_module():
     b = kernels.KernelKey("auvtrack.control.fxtntsmc", "auvtrack.plant.five_dof")
     assert a.name != b.name
     assert kernels.kernel_module(a) is not kernels.kernel_module(b)
-    assert kernels.kernel_module(a).law is kernels.law_module("auvtrack.control.ftsmc").control
+    law = kernels.kernel_module(a).law  # the law's code, compiled once for LLVM to inline (_jit.llvm_inline)
+    assert law.py_func.__code__ is kernels.law_module("auvtrack.control.ftsmc").control.py_func.__code__
+    assert law.targetoptions["forceinline"] and "inline" not in law.targetoptions
 
 
 def test_a_plugin_kernel_is_named_by_the_file_content(tmp_path):

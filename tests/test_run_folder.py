@@ -246,3 +246,44 @@ def test_concurrent_runs_without_out_each_get_their_own_folder(tmp_path, monkeyp
         assert (folder / "trajectory.csv").read_bytes() == expected[duration]
         seen.add(duration)
     assert seen == set(DURATIONS)
+
+
+def test_a_folder_moved_aside_while_it_is_checked_counts_as_absent(tmp_path):
+    """Concurrent writers rename run folders in and out: a folder that vanishes between the look
+    at the path and the listing is absent (not "cannot be read"), so a concurrent run is not refused."""
+    from auvtrack.simulation.result import run_folder_problem
+
+    folder = tmp_path / "run"
+    folder.mkdir()
+    with mock.patch("auvtrack.simulation.result.os.listdir", side_effect=FileNotFoundError(2, "gone")):
+        assert run_folder_problem(folder) is None
+    with mock.patch("auvtrack.simulation.result.os.listdir", side_effect=PermissionError(13, "denied")):
+        assert "cannot be read" in run_folder_problem(folder)
+
+
+def test_publish_looks_again_when_the_folder_is_replaced_during_its_check(tmp_path):
+    """A reason found while another writer swapped the folder is not trusted: publish retries and
+    succeeds; a reason about the same, unchanged folder is final."""
+    from auvtrack._atomic import FolderError, make_temp_folder, publish_folder
+
+    final = tmp_path / "run"
+    final.mkdir()
+    (final / "run.json").write_text("{}")
+    calls = []
+
+    def racing(path):  # the first check sees a folder that another writer then moves aside
+        calls.append(path)
+        if len(calls) == 1:
+            os.rename(path, tmp_path / "moved")
+            return "cannot be read (No such file or directory)"
+        return None
+
+    tmp = make_temp_folder(final)
+    (tmp / "run.json").write_text('{"new": 1}')
+    publish_folder(tmp, final, racing)
+    assert json.loads((final / "run.json").read_text()) == {"new": 1}
+
+    tmp2 = make_temp_folder(final)
+    with pytest.raises(FolderError, match="not replaceable"):
+        publish_folder(tmp2, final, lambda p: "not replaceable")
+    assert tmp2.exists() and json.loads((final / "run.json").read_text()) == {"new": 1}

@@ -5,6 +5,7 @@ import math
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -16,6 +17,7 @@ from auvtrack import _jit, _vecmath
 from auvtrack._vecmath import atanh4, exp8, pow4, sincos4
 from auvtrack.control import fxtntsmc, rbf
 
+ROOT = Path(__file__).resolve().parents[1]
 MAX_ULP = 4  # glibc's bound for libmvec (manual, "Errors in Math Functions")
 
 
@@ -174,8 +176,10 @@ def test_rbf_basis_matches_eq12_for_any_neuron_count(m):
 
 def _law_points(tmp_path, backend_env: str, given=None) -> dict:
     out = tmp_path / f"law-{backend_env}.npz"
-    subprocess.run([sys.executable, "tests/law_points.py", str(out)] + ([str(given)] if given else []),
-                   check=True, env={**os.environ, "AUVTRACK_LIBMVEC": backend_env})
+    subprocess.run([sys.executable, str(ROOT / "tests" / "law_points.py"), str(out)] + ([str(given)] if given else []),
+                   check=True, env={**os.environ, "AUVTRACK_LIBMVEC": backend_env,
+                                    "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))},
+                   cwd=ROOT)
     return dict(np.load(out))
 
 
@@ -275,3 +279,69 @@ def test_fused_estimator_update_is_the_per_axis_one_bit_for_bit(m, seed):
     assert np.array_equal(c1, c2)
     assert np.array_equal(d1, d2, equal_nan=True)  # same slots written, the others untouched
     assert np.isnan(d1[:off]).all() and not np.isnan(d1[off:off + 3 * m]).any()
+
+
+def _vector_array_call(name: str, lanes: int, nargs: int):
+    """A compiled loop calling the vector-ABI function ``name`` (``lanes`` wide) on rows of an array."""
+    from llvmlite import ir
+    from numba import types
+    from numba.core import cgutils
+    from numba.extending import intrinsic
+
+    @intrinsic
+    def call(typingctx, x, out):
+        def codegen(context, builder, sig, args):
+            xa = context.make_array(sig.args[0])(context, builder, args[0])
+            oa = context.make_array(sig.args[1])(context, builder, args[1])
+            vty = ir.VectorType(ir.DoubleType(), lanes)
+            fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(vty, [vty] * nargs), name)
+            rows = builder.extract_value(xa.shape, 0)
+            i64 = ir.IntType(64)
+            with cgutils.for_range(builder, rows) as loop:
+                vals = []
+                for a in range(nargs):
+                    off = builder.add(builder.mul(loop.index, ir.Constant(i64, nargs * lanes)), ir.Constant(i64, a * lanes))
+                    vals.append(builder.load(builder.bitcast(builder.gep(xa.data, [off]), vty.as_pointer()), align=8))
+                dst = builder.gep(oa.data, [builder.mul(loop.index, ir.Constant(i64, lanes))])
+                builder.store(builder.call(fn, vals), builder.bitcast(dst, vty.as_pointer()), align=8)
+            return context.get_dummy_value()
+
+        return types.none(x, out), codegen
+
+    @numba.njit
+    def run(x, out):
+        call(x, out)
+
+    return run
+
+
+@pytest.mark.skipif(not _vecmath.WIDE, reason="no AVX-512 forms of the libmvec functions on this machine")
+@pytest.mark.parametrize("narrow", sorted(_vecmath.WIDE_PAIRS))
+def test_avx512_forms_return_the_bits_of_the_avx2_forms(narrow):
+    """The 8-lane lane kernels evaluate pow, exp, sin, cos 8 runs per AVX-512 call: the same bits as the
+    4-lane AVX2 calls of single runs, or the SIMD back end would not reproduce single runs."""
+    wide = _vecmath.WIDE_PAIRS[narrow]
+    nargs = 2 if "vv" in narrow else 1
+    rng = np.random.default_rng(5)
+    n = 8 * 12500
+    specials = np.array([0.0, -0.0, 1e-310, -1e-310, 5e-324, 1.0, -1.0, 0.5, 2.0, 700.0, -745.0, 1e300, np.inf, -np.inf,
+                         np.nan, 1e-8, math.pi, -math.pi, 1e6, 3e9])
+    if nargs == 2:
+        base = np.concatenate([rng.uniform(0.0, 3.0, n // 2), 10.0 ** rng.uniform(-300, 300, n // 2)])
+        base[: specials.size] = np.abs(specials)
+        expo = np.concatenate([rng.uniform(-1.0, 2.0, n // 2), rng.uniform(-50, 50, n // 2)])
+        expo[specials.size: 2 * specials.size] = specials
+        args = [base, rng.permutation(expo)]
+    else:
+        lo, hi = {"exp": (-745.0, 710.0)}.get(narrow.split("_")[-1], (-1e4, 1e4))
+        x = np.concatenate([rng.uniform(-3.0, 3.0, n // 2), rng.uniform(lo, hi, n // 2)])
+        x[: specials.size] = specials
+        args = [x]
+
+    def layout(w):
+        return np.ascontiguousarray(np.stack([a.reshape(-1, w) for a in args], 1).reshape(-1, nargs * w))
+
+    got4, got8 = np.zeros(n), np.zeros(n)
+    _vector_array_call(narrow, 4, nargs)(layout(4), got4)
+    _vector_array_call(wide, 8, nargs)(layout(8), got8)
+    np.testing.assert_array_equal(got8.view(np.int64), got4.view(np.int64))

@@ -36,7 +36,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 from .._jit import njit_noalloc
 from ..plant.kinematics import attitude, body_from_ned
@@ -114,6 +113,8 @@ class GaussMarkovCurrent:
         dev = np.empty((n, 3))
         dev[0] = y0
         # AR(1) y_k = a y_{k-1} + c sigma z_k, run by lfilter with initial condition a y_0
+        from scipy.signal import lfilter  # imported here: scipy.signal costs a second at every start
+
         dev[1:], _ = lfilter([c], [1.0, -a], sigma * z[1:], axis=0, zi=(a * y0)[None, :])
         out = np.empty((n, CUR_COLS))
         out[:, 0] = h * np.arange(n)

@@ -23,6 +23,7 @@ import math
 import os
 import threading
 import time
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Iterator, Sequence
@@ -36,10 +37,10 @@ from ..simulation.engine import Outputs
 from ..simulation.metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from ..simulation.result import Result
 
-BACKENDS = ("threads", "prange", "serial")
+BACKENDS = ("threads", "prange", "serial", "simd")
 
 __all__ = ["RunSummary", "run_metrics", "run_batch", "iter_batch", "BACKENDS", "default_workers", "StopSignal",
-           "BatchInterrupted"]
+           "BatchInterrupted", "preferred_backend"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,27 @@ class RunSummary:
     def ok(self) -> bool:
         """True when the run reached its end without failure."""
         return self.status == "ok"
+
+
+def preferred_backend(threads: str = "threads") -> str:
+    """The back end for many metrics-only runs: ``"simd"`` where the vector math library is in use, else ``threads``.
+
+    Without libmvec (``auvtrack._vecmath.BACKEND == "scalar"``) every vector math call of a lane
+    kernel becomes one scalar call per lane, and the lanes lose most of their advantage.
+
+    Parameters
+    ----------
+    threads : str, optional
+        The back end to use otherwise (``"serial"`` for one core per process, as in a Dask worker).
+
+    Returns
+    -------
+    str
+        A name of :data:`BACKENDS`.
+    """
+    from .._vecmath import BACKEND
+
+    return "simd" if BACKEND == "avx2" else threads
 
 
 def default_workers() -> int:
@@ -200,6 +222,115 @@ def _run_prange(preps: Sequence[Prepared], stop: StopSignal) -> list[RunSummary]
     return out  # type: ignore[return-value]
 
 
+def _lane_stack(arrays: list[np.ndarray], lanes: int) -> np.ndarray:
+    """Stack n equal-shape arrays into blocks of ``lanes`` runs along a last axis: (blocks, *shape, lanes).
+
+    The last block is padded with copies of its first run (padding lanes are computed, never read).
+    """
+    a = np.stack(arrays)
+    n = a.shape[0]
+    nb = -(-n // lanes)
+    if nb * lanes > n:
+        a = np.concatenate([a, np.repeat(a[(nb - 1) * lanes:(nb - 1) * lanes + 1], nb * lanes - n, axis=0)])
+    a = a.reshape((nb, lanes) + a.shape[1:])
+    return np.ascontiguousarray(np.moveaxis(a, 1, -1))
+
+
+MIN_LANES = 4
+"""Fewer runs than this left over in a group run on the single-run kernel rather than in a block of
+mostly empty lanes (a block costs about what 3 single runs cost, ``benchmarks/results.md``)."""
+
+
+class _LaneGroup:
+    """The runs of one group stacked in blocks of LANES along a last axis, with the lane kernel's outputs."""
+
+    def __init__(self, module, ps: list[Prepared], stop: StopSignal) -> None:
+        L = engine.LANES
+        self.module, self.ps, n = module, ps, len(ps)
+        self.nb = nb = -(-n // L)
+        accs0 = []
+        for _ in range(n):
+            a = np.empty(METRICS_SIZE)
+            metrics_init(a)
+            accs0.append(a)
+        self.accs = _lane_stack(accs0, L)
+        self.fails = np.zeros((nb, 2, ps[0].n_state, L))
+        self.infos = np.zeros((nb, engine.INFO_SIZE, L), dtype=np.int64)
+        stop.register(np.moveaxis(self.infos, 1, -1))  # a view: the stop flag reaches every lane
+        counts = np.array([min(L, n - b * L) for b in range(nb)], dtype=np.int64)
+        self.causes = np.zeros((nb, L), dtype=np.int64)
+        self.t_stops = np.zeros((nb, L))
+        logs = np.zeros((nb, 0, len(ps[0].channels), L))
+        self.args = (_lane_stack([p.plant.pp for p in ps], L), _lane_stack([p.plant.x0 for p in ps], L),
+                     _lane_stack([p.cp for p in ps], L), _lane_stack([p.controller.x0 for p in ps], L),
+                     _lane_stack([p.vp_nom for p in ps], L), _lane_stack([p.environment.rows for p in ps], L),
+                     _lane_stack([p.environment.current for p in ps], L),
+                     _lane_stack([p.environment.noise for p in ps], L), _lane_stack([p.ref_p for p in ps], L),
+                     _lane_stack([p.si for p in ps], L), _lane_stack([p.sf for p in ps], L), logs, self.accs,
+                     self.fails, self.infos, counts, self.causes, self.t_stops)
+
+    def run_block(self, b: int) -> None:
+        """Run block ``b`` (the kernel releases the GIL)."""
+        self.module.run_lanes(*self.args, b, b + 1)
+
+    def summary(self, k: int) -> RunSummary:
+        """The outcome of the group's run ``k``."""
+        b, lane = divmod(k, engine.LANES)
+        p = self.ps[k]
+        o = Outputs(np.empty((0, len(p.channels))), np.ascontiguousarray(self.accs[b, :, lane]),
+                    np.ascontiguousarray(self.fails[b, :, :, lane]), np.ascontiguousarray(self.infos[b, :, lane]))
+        return _summary(p, int(self.causes[b, lane]), float(self.t_stops[b, lane]), o)
+
+
+def _run_simd(preps: Sequence[Prepared], stop: StopSignal, workers: int) -> list[RunSummary]:
+    """Runs grouped by kernel and array shapes, each group in blocks of LANES runs (one per SIMD lane).
+
+    Within a group, runs are sorted by length so that a block's lanes end together; the blocks, and
+    the runs that go to the single-run kernel (fewer than :data:`MIN_LANES` left over in a group, or
+    a group whose law or plant has no lane form, :class:`~auvtrack.simulation.lanes.NotLaneable`,
+    which is warned about) are spread over ``workers`` threads.
+    """
+    from ..simulation.lanes import NotLaneable
+
+    L = engine.LANES
+    groups: dict[tuple, list[int]] = {}
+    for i, p in enumerate(preps):
+        groups.setdefault(_shape_key(p), []).append(i)
+    out: list[RunSummary | None] = [None] * len(preps)
+    lane_groups: list[tuple[list[int], _LaneGroup]] = []
+    singles: list[int] = []
+    for idx in groups.values():
+        idx = sorted(idx, key=lambda i: preps[i].n_steps)
+        rest = len(idx) % L
+        if 0 < rest < MIN_LANES:
+            singles += idx[len(idx) - rest:]
+            idx = idx[:len(idx) - rest]
+        if not idx:
+            continue
+        try:
+            module = kernels.lanes_module(preps[idx[0]].key)
+        except NotLaneable as exc:
+            key = preps[idx[0]].key
+            warnings.warn(f"simd back end: {key.label or key.name} has no lane form ({exc}); "
+                          "its runs use the thread back end", stacklevel=3)
+            singles += idx
+            continue
+        lane_groups.append((idx, _LaneGroup(module, [preps[i] for i in idx], stop)))
+    tasks: list[Callable[[], Any]] = [lambda g=g, b=b: g.run_block(b) for _, g in lane_groups for b in range(g.nb)]
+    tasks += [lambda i=i: out.__setitem__(i, run_metrics(preps[i], stop)) for i in singles]
+    if workers == 1 or len(tasks) == 1:
+        for task in tasks:
+            task()
+    else:
+        with ThreadPoolExecutor(max_workers=min(workers, len(tasks))) as pool:
+            for f in [pool.submit(task) for task in tasks]:
+                f.result()
+    for idx, g in lane_groups:
+        for k, i in enumerate(idx):
+            out[i] = g.summary(k)
+    return out  # type: ignore[return-value]
+
+
 def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers: int | None = None,
               backend: str = "threads") -> list[RunSummary] | list[Result]:
     """Run many prepared scenarios, in parallel, and return their outcomes in order.
@@ -214,8 +345,10 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     workers : int, optional
         Threads (``"threads"`` back end); default :func:`default_workers`.  The ``"prange"``
         back end uses Numba's thread count (``NUMBA_NUM_THREADS``).
-    backend : {"threads", "prange", "serial"}
-        How runs are spread over cores (``trajectories`` always uses threads).
+    backend : {"threads", "prange", "serial", "simd"}
+        How runs are spread over cores (``trajectories`` always uses threads); ``"simd"`` runs
+        groups of equal kernel and shapes in the lanes of a SIMD register, falling back to the
+        thread back end (with a warning) for a law or plant without a lane form.
 
     Returns
     -------
@@ -243,6 +376,8 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     fn: Callable[[Prepared, StopSignal], Any] = _trajectory if trajectories else run_metrics
     if backend == "prange" and not trajectories:
         return _guarded(lambda: _run_prange(preps, stop), stop)
+    if backend == "simd" and not trajectories:
+        return _guarded(lambda: _run_simd(preps, stop, workers), stop)
     if backend == "serial" or workers == 1 or len(preps) == 1:
         workers = 1
     pool = ThreadPoolExecutor(max_workers=min(workers, len(preps)))

@@ -44,6 +44,29 @@ def builtin_controllers() -> tuple[str, ...]:
     return tuple(n for n in BUILTIN_NAMES if n != "open_loop_actuators")
 
 
+SIXDOF_ONLY: tuple[str, ...] = ("open_loop_actuators",)
+"""Built-in controllers that only run on a 6-DOF plant (fin and propeller commands)."""
+
+
+def builtin_pairs(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = ()) -> list[tuple[str, str]]:
+    """(controller, plant) pairs a run can use: every built-in controller on every plant it runs on.
+
+    Parameters
+    ----------
+    controllers, plants : tuple of str, optional
+        Registered names (default: every built-in controller, :data:`SIXDOF_ONLY` included, and every plant).
+
+    Returns
+    -------
+    list of (str, str)
+        The pairs, controllers in registry order; a :data:`SIXDOF_ONLY` controller only with ``"6dof"``.
+    """
+    from ..plant import PLANTS
+
+    cs = controllers or builtin_controllers() + SIXDOF_ONLY
+    return [(c, p) for c in cs for p in (plants or tuple(PLANTS)) if c not in SIXDOF_ONLY or p == "6dof"]
+
+
 def plugin_copy(kind: str, folder: Path) -> Path:
     """Write built-in controller ``kind``'s module as a stand-alone plug-in file (absolute imports).
 
@@ -167,7 +190,8 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     Parameters
     ----------
     controllers, plants : tuple of str, optional
-        Registered names (default: all).
+        Registered names (default: every built-in controller on every plant it runs on,
+        :func:`builtin_pairs`; a 6-DOF plant's kernels one per preset module).
     progress : bool, optional
         Show a progress bar while compiling.
 
@@ -176,11 +200,10 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     dict
         ``{"kernels": [...], "compiled": [...], "seconds": wall time}``.
     """
-    from ..plant import PLANTS
     from ..simulation import kernels
     from ..simulation.api import kernel_keys
 
-    keys = kernel_keys([(c, p) for c in (controllers or builtin_controllers()) for p in (plants or tuple(PLANTS))])
+    keys = kernel_keys(builtin_pairs(controllers, plants))
     t0 = time.perf_counter()
     done = kernels.warmup(keys, progress=progress)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
@@ -212,9 +235,10 @@ def user_bench_folder() -> Path:
 def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = False) -> dict:
     """The full benchmark suite; writes ``results.json`` and ``results.md`` into ``out``.
 
-    Single-run µs per RK4 step for every controller, batch runs/s (10 s runs at dt = 1 ms) per
-    back end, and sweep throughput on 1 and 2 Dask workers (see
-    :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to a new user folder
+    Time to the first result with an empty kernel cache (a cold ``auvtrack run`` and a cold
+    ``auvtrack warmup``, each in a new process), single-run µs per RK4 step for every controller,
+    batch runs/s (10 s runs at dt = 1 ms) and efficiency per back end, and sweep throughput on 1
+    and 2 Dask workers (see :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to a new user folder
     (:func:`user_bench_folder`), so running the suite from a clone leaves the working tree
     unchanged; pass ``out=Path("benchmarks")`` to update the record kept in the repository.
 
@@ -232,10 +256,14 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     dict
         The record written to ``results.json``, plus ``"out"``: the folder (not written).
     """
-    from .sweep_bench import bench_batch, bench_breakdown, bench_sweep, write_results
+    from .sweep_bench import (bench_batch, bench_breakdown, bench_cold_start, bench_cold_warmup, bench_sweep,
+                              write_results)
 
     say = print if progress else (lambda *a, **k: None)
     mach = machine()  # load average before our own runs
+    say("cold start")
+    cold = bench_cold_start()
+    cold_warmup = bench_cold_warmup()
     say("single runs")
     folder = _jit.cache_dir() / "bench_plugins"  # a fixed place: the plug-in kernels stay cached
     folder.mkdir(parents=True, exist_ok=True)
@@ -250,12 +278,12 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     batch = bench_batch(repeat=repeat)
     say("sweep")
     sweep = bench_sweep(repeat=max(3, repeat // 2))
-    doc = {"machine": mach, "repeat": repeat, "single": single, "breakdown": breakdown, "batch": batch,
-           "sweep": sweep}
+    doc = {"machine": mach, "repeat": repeat, "cold": cold, "cold_warmup": cold_warmup, "single": single,
+           "breakdown": breakdown, "batch": batch, "sweep": sweep}
     out = Path(out) if out is not None else user_bench_folder()
     write_results(doc, out)
     return {**doc, "out": out}
 
 
 __all__ = ["bench_single", "bench_singles", "bench_all", "user_bench_folder", "warmup", "machine",
-           "builtin_controllers", "plugin_copy"]
+           "builtin_controllers", "builtin_pairs", "SIXDOF_ONLY", "plugin_copy"]

@@ -9,7 +9,7 @@ import tempfile
 import time
 from pathlib import Path
 
-BATCH_RUNS = 40
+BATCH_RUNS = 48  # a multiple of 2 cores x 8 SIMD lanes, so that no back end idles a core on the last runs
 RUN_SECONDS = 10.0
 SWEEP_SAMPLES_PER_KIND = 60
 
@@ -89,29 +89,32 @@ def bench_batch(*, repeat: int = 5, runs: int = BATCH_RUNS, duration: float = RU
     """
     from .batch import default_workers, run_batch
 
-    kinds, backends = ("ftsmc", "fxtntsmc"), ("serial", "threads", "prange")
+    kinds, backends = ("ftsmc", "fxtntsmc"), ("serial", "threads", "simd", "prange")
     preps, prep_ms = {}, {}
     for kind in kinds:
         _preps(kind, 2, duration)  # first call pays imports and one-off caches
         t0 = time.perf_counter()
         preps[kind] = _preps(kind, runs, duration)
         prep_ms[kind] = 1e3 * (time.perf_counter() - t0) / runs
-        for backend in ("prange", "serial", "threads"):  # warm; prange first (see below)
+        for backend in ("prange", "serial", "threads", "simd"):  # warm (and compile); prange first (see below)
             run_batch(preps[kind][:2], backend=backend)
     rates: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
-    # controllers and the serial and thread-pool back ends interleaved (a slow spell of the
+    cpu: dict[tuple[str, str], list[float]] = {(k, b): [] for k in kinds for b in backends}
+    # controllers and the serial, thread-pool and SIMD back ends interleaved (a slow spell of the
     # machine hits them alike); prange in a block of its own, last: after a prange call the
     # OpenMP layer's threads keep spinning for a while and would steal the core from a serial
     # or thread-pool run that followed at once
-    for block in (("serial", "threads"), ("prange",)):
+    for block in (("serial", "threads", "simd"), ("prange",)):
         for _ in range(repeat):
             for backend in block:
                 for kind in kinds:
-                    t0 = time.perf_counter()
+                    t0, c0 = time.perf_counter(), time.process_time()
                     run_batch(preps[kind], backend=backend)
                     rates[(kind, backend)].append(runs / (time.perf_counter() - t0))
+                    cpu[(kind, backend)].append((time.process_time() - c0) / runs)
     return [{"controller": kind, "backend": backend, "runs": runs, "run_seconds": duration,
              "runs_per_s": round(statistics.median(r), 2), "max_runs_per_s": round(max(r), 2),
+             "cpu_ms_per_run": round(1e3 * statistics.median(cpu[(kind, backend)]), 3),
              "prepare_ms_per_run": round(prep_ms[kind], 3), "cores": default_workers(), "repeat": repeat,
              "load_avg_1min": _load()} for (kind, backend), r in rates.items()]
 
@@ -162,6 +165,71 @@ def bench_sweep(*, repeat: int = 3, workers: tuple[int, ...] = (1, 2), duration:
     return rows
 
 
+def batch_efficiency(row: dict, us_per_step: float, dt: float = 0.001) -> float:
+    """Runs per second per core x RK4 steps per run x the single run's seconds per step.
+
+    1 means a core does in the batch what it does in single runs; a SIMD back end that runs L
+    runs per register can exceed 1 (at most about L).
+    """
+    steps = round(row["run_seconds"] / dt)
+    return row["runs_per_s"] / row["cores"] * steps * us_per_step * 1e-6
+
+
+def batch_cpu_efficiency(row: dict, cpu_us_per_step: float, dt: float = 0.001) -> float:
+    """The single run's CPU time per run over the batch's CPU time per run (all threads of the process).
+
+    :func:`batch_efficiency` from CPU time instead of wall time: less disturbed by other processes
+    on a shared machine (it cannot see two threads slowing each other down on one core).
+    """
+    steps = round(row["run_seconds"] / dt)
+    return steps * cpu_us_per_step * 1e-3 / row["cpu_ms_per_run"]
+
+
+def bench_cold_start(*, duration: float = 1.0) -> dict:
+    """Wall time of ``auvtrack run`` of the Section 4 scenario in a new process with an empty kernel cache.
+
+    What a user waits for on a fresh install: imports, scenario validation, compiling the one
+    kernel the run needs (and nothing else), the run, writing its folder.  Also reports the kernel
+    compile time the run recorded (its cache marker).
+    """
+    import subprocess
+    import sys
+
+    from ..scenario import paper_scenario_path
+
+    with tempfile.TemporaryDirectory() as tmp:
+        env = {**os.environ, "AUVTRACK_CACHE_DIR": str(Path(tmp) / "cache")}
+        load = _load()
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-m", "auvtrack.cli", "run", str(paper_scenario_path()), "--set",
+                               f"sim.duration={duration}", "--out", str(Path(tmp) / "run")], env=env, cwd=tmp,
+                              capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        markers = [json.loads(m.read_text()) for m in (Path(tmp) / "cache").glob("*/kernels/*.compiled.json")]
+    if proc.returncode != 0:
+        raise RuntimeError(f"cold run failed: {proc.stderr.strip()[-500:]}")
+    return {"seconds": round(wall, 2), "compile_seconds": round(sum(m["seconds"] for m in markers), 2),
+            "kernels_compiled": [m["kernel"] for m in markers], "run_seconds": duration, "load_avg_1min": load}
+
+
+def bench_cold_warmup() -> dict:
+    """Wall time of ``auvtrack warmup`` (every built-in controller on every plant it runs on) with an empty cache."""
+    import subprocess
+    import sys
+
+    with tempfile.TemporaryDirectory() as tmp:
+        env = {**os.environ, "AUVTRACK_CACHE_DIR": str(Path(tmp) / "cache")}
+        load = _load()
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-m", "auvtrack.cli", "warmup"], env=env, cwd=tmp,
+                              capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise RuntimeError(f"cold warmup failed: {proc.stderr.strip()[-500:]}")
+    doc = json.loads(proc.stdout.strip().splitlines()[-1])
+    return {"seconds": round(wall, 2), "kernels": len(doc["kernels"]), "load_avg_1min": load}
+
+
 def write_results(doc: dict, out: Path) -> None:
     """Write ``results.json`` and ``results.md`` (medians and ratios) into ``out``."""
     import datetime
@@ -204,11 +272,33 @@ def write_results(doc: dict, out: Path) -> None:
                   "| variant | CPU µs / step |", "|---|---|"]
         lines += [f"| {r['variant']} | {r['cpu_us_per_step']:.2f} |" for r in doc["breakdown"]]
         lines += [""]
+    if doc.get("cold"):
+        c, w = doc["cold"], doc.get("cold_warmup")
+        lines += ["## Time to the first result (empty kernel cache, new process)", "",
+                  "| what | wall s | load before |", "|---|---|---|",
+                  f"| `auvtrack run` Section 4 ({c['run_seconds']:g} s), compiling {', '.join(c['kernels_compiled'])} "
+                  f"({c['compile_seconds']:.1f} s of it) | {c['seconds']:.1f} | {c['load_avg_1min']} |"]
+        if w:
+            lines += [f"| `auvtrack warmup`: {w['kernels']} kernels (every built-in controller on every plant it runs "
+                      "on, one per 6-DOF preset module) | "
+                      f"{w['seconds']:.1f} | {w['load_avg_1min']} |"]
+        lines += [""]
     lines += ["## Batch runner (metrics only, 10 s runs at dt = 1 ms)", "",
-              "| controller | back end | runs / s (median) | best | prepare ms / run (serial Python) | load after |",
-              "|---|---|---|---|---|---|"]
+              "Efficiency = runs / s per core x steps per run x the single run's wall µs per step (table above): 1 "
+              "is a core doing in the batch what it does in single runs; `simd` runs several simulations in the "
+              "lanes of one SIMD register.", "",
+              "| controller | back end | runs / s (median) | best | efficiency | CPU ms / run | CPU efficiency | "
+              "prepare ms / run (serial Python) | load after |",
+              "|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['controller']} | {r['backend']} | {r['runs_per_s']:.1f} | {r['max_runs_per_s']:.1f} | "
-              f"{r['prepare_ms_per_run']:.2f} | {r['load_avg_1min']} |" for r in doc["batch"]]
+              f"{batch_efficiency(r, single[r['controller']]['us_per_step']):.2f} | "
+              + (f"{r['cpu_ms_per_run']:.2f} | "
+                 f"{batch_cpu_efficiency(r, single[r['controller']]['cpu_us_per_step']):.2f} | "
+                 if "cpu_ms_per_run" in r else "| | ")
+              + f"{r['prepare_ms_per_run']:.2f} | {r['load_avg_1min']} |" for r in doc["batch"]]
+    lines += ["", "CPU efficiency: the single run's CPU time per run (20 s runs, table above) over the batch's "
+              "process CPU time per run; unlike the wall-time efficiency it does not drop when other processes "
+              "take the cores."]
     lines += ["", "## Sweep on Dask distributed (LocalCluster, processes, 1 thread each)", "",
               f"{doc['sweep'][0]['samples']} samples of {doc['sweep'][0]['run_seconds']:g} s (half FTSMC, half "
               "FXTNTSMC, chunks of 10), including per-sample scenario validation and preparation and the "

@@ -143,12 +143,13 @@ def run_samples(spec: StudySpec, indices: list[int]):
         ``"failed"`` and cause ``"memory"`` and is not run; a simulation failure has status
         ``"failed"``, its cause and time.
     """
-    from .batch import run_batch
+    from .batch import preferred_backend, run_batch
 
     budget = worker_memory_budget()
     prepared = [_prepare_sample(spec, i, budget) for i in indices]
     runnable = [p for _, p in prepared if not isinstance(p, tuple)]
-    summaries = iter(run_batch(runnable, backend="serial"))
+    # one core per worker: its SIMD lanes (runner.batch.preferred_backend)
+    summaries = iter(run_batch(runnable, backend=preferred_backend("serial"), workers=1))
     rows = []
     for i, (seed, prep) in zip(indices, prepared):
         row = _base_row(spec, i, seed)

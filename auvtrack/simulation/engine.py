@@ -120,15 +120,22 @@ class Outputs(NamedTuple):
 
 KERNEL_PARTS: dict[str, str] = {}
 """Name of each kernel part -> the decorator it is compiled with in a generated kernel module."""
+LANE_PARTS: dict[str, str] = {}
+"""The same for the parts of the SIMD batch module of a pair (:func:`run_lanes`)."""
+LANES = 8
+"""Runs per block of the lane kernels: the float64 lanes of one 512-bit AVX-512 register (two AVX2 registers)."""
 
 
-def kernel_part(decorator: str):
+def kernel_part(decorator: str, *, lanes: bool = False):
     """Mark a function as part of the loop that :mod:`auvtrack.simulation.kernels` copies per (law, plant).
 
     Parameters
     ----------
     decorator : str
         Python source of the decorator the copy gets, e.g. ``"njit(nogil=True)"``.
+    lanes : bool, optional
+        A part of the SIMD batch module (compiled only when that back end runs) instead of the
+        kernel module.
 
     Returns
     -------
@@ -136,7 +143,7 @@ def kernel_part(decorator: str):
         A decorator that records the function and returns it unchanged (not compiled here).
     """
     def mark(fn):
-        KERNEL_PARTS[fn.__name__] = decorator
+        (LANE_PARTS if lanes else KERNEL_PARTS)[fn.__name__] = decorator
         return fn
     return mark
 
@@ -243,6 +250,18 @@ def stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, wo
     return 0, flags
 
 
+@kernel_part("njit_noalloc")
+def control_sample(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+    """The law at one control sample (sampled-data mode), behind a call.
+
+    A law compiled with ``inline="always"`` is copied into every function that calls it; called
+    from here, :func:`run` holds no copy of its own (the law is inlined into :func:`stage`, where
+    it runs at every stage, and here), which halves what Numba compiles of it.  Once per sample,
+    the call costs nothing measurable.
+    """
+    return law(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work)  # noqa: F821
+
+
 @kernel_part("njit")
 def log_row(log, row, t, xp, cmd, pp, tau, refm, e, aux, naux, dxp, vp):
     """Fill one logged row (see N_BASE_COLS); chi uses the nominal model with the produced input."""
@@ -301,7 +320,7 @@ def run(pb, cb, env, ref_p, settings, out):
             eval_reference(ref_p, t, refm)
             eta_t, nu_t = plant.pose(xp)  # noqa: F821
             eta, nu = measure(eta_t, nu_t, env.noise, k // ctrl_every)
-            status = law(t, eta, nu, attitude(eta[3], eta[4]), xc, refm, vp, cp, tau1, kc1, aux1, work)  # noqa: F821
+            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, refm, vp, cp, tau1, kc1, aux1, work)
             if status == 0 and not finite3(tau1):
                 status = STATUS_NONFINITE_INPUT
             if status != 0:
@@ -389,3 +408,31 @@ def run_many(pps, xp0s, cps, xc0s, vps, rowss, curs, noises, refs, sis, sfs, nco
                                Outputs(log, accs[i], fails[i], infos[i]))
         causes[i] = cause
         t_stops[i] = t_stop
+
+
+@kernel_part("njit(nogil=True)", lanes=True)
+def run_lanes(pps, xp0s, cps, xc0s, vps, rowss, curs, noises, refs, sis, sfs, logs, accs, fails, infos, counts, causes,
+              t_stops, b0, b1):
+    """:func:`run` of LANES runs at once, one per lane of a SIMD register, for the blocks b0 .. b1 - 1.
+
+    Block ``b`` of every argument holds ``counts[b]`` runs along its last axis (length LANES; the
+    lanes beyond ``counts[b]`` are padding and never written back).  ``run__lanes`` is the lane
+    form of :func:`run` (:mod:`auvtrack.simulation.lanes`): the same loop, each run's branches
+    taken in its own lane, a run that stops leaving its lane with its own cause and time.  Writes
+    ``accs``, ``fails``, ``infos`` (the runs' metrics accumulators, stop states and steps) and
+    ``causes``, ``t_stops`` (block, lane).
+    """
+    for b in range(b0, b1):
+        m = first_lanes(counts[b], LANES)  # noqa: F821  (bound in the lanes module)
+        out = Outputs(as_lanes(logs[b], LANES), as_lanes(accs[b], LANES), as_lanes(fails[b], LANES),  # noqa: F821
+                      as_lanes(infos[b], LANES))  # noqa: F821
+        cause, _, t_stop = run__lanes(PlantBundle(as_lanes(pps[b], LANES), as_lanes(xp0s[b], LANES)),  # noqa: F821
+                                      ControllerBundle(as_lanes(cps[b], LANES), as_lanes(xc0s[b], LANES),  # noqa: F821
+                                                       as_lanes(vps[b], LANES)),  # noqa: F821
+                                      EnvironmentBundle(as_lanes(rowss[b], LANES), as_lanes(curs[b], LANES),  # noqa: F821
+                                                        as_lanes(noises[b], LANES)),  # noqa: F821
+                                      as_lanes(refs[b], LANES), Settings(as_lanes(sis[b], LANES),  # noqa: F821
+                                                                          as_lanes(sfs[b], LANES)), out, m)  # noqa: F821
+        for k in range(counts[b]):
+            causes[b, k] = get_lane(cause, k)  # noqa: F821
+            t_stops[b, k] = get_lane(t_stop, k)  # noqa: F821

@@ -16,6 +16,7 @@ import math
 import os
 import re
 import shutil
+import stat
 from pathlib import Path
 from typing import Any, BinaryIO, Iterator, Mapping
 
@@ -155,19 +156,26 @@ def run_folder_problem(folder: str | os.PathLike) -> str | None:
     long = [p for p in path.parts if len(p.encode("utf-8", "surrogateescape")) > limit]
     if long:
         return f"{text}: the name {long[0][:40]!r}... is longer than {limit} bytes"
-    if path.is_symlink():
+    try:  # one look at the path itself: concurrent writers rename run folders in and out of it
+        mode = os.lstat(path).st_mode
+    except (FileNotFoundError, NotADirectoryError):  # absent (a parent that is a file: reported on creation)
+        return None
+    except OSError as exc:
+        return f"{text}: cannot be read ({exc.strerror or exc})"
+    if stat.S_ISLNK(mode):
         return f"{text}: is a symbolic link; give the folder itself"
-    if path.exists() and not path.is_dir():
+    if not stat.S_ISDIR(mode):
         return f"{text}: is a file, not a folder"
-    if path.is_dir():
-        try:
-            foreign = sorted(e for e in os.listdir(path) if e not in RUN_FILES)
-        except OSError as exc:
-            return f"{text}: cannot be read ({exc.strerror or exc})"
-        if foreign:
-            shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
-            return (f"{text}: holds {len(foreign)} entr{'y' if len(foreign) == 1 else 'ies'} that a run folder "
-                    f"does not ({shown}); choose an empty folder or a run folder")
+    try:
+        foreign = sorted(e for e in os.listdir(path) if e not in RUN_FILES)
+    except FileNotFoundError:  # moved aside since the look above: absent
+        return None
+    except OSError as exc:
+        return f"{text}: cannot be read ({exc.strerror or exc})"
+    if foreign:
+        shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+        return (f"{text}: holds {len(foreign)} entr{'y' if len(foreign) == 1 else 'ies'} that a run folder "
+                f"does not ({shown}); choose an empty folder or a run folder")
     return None
 
 

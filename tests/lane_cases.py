@@ -1,0 +1,85 @@
+"""Compiled functions exercising every construct of the lane rewrite (auvtrack.simulation.lanes), for tests.
+
+Each is an ordinary compiled function of scalars; tests/test_simd.py checks that its lane form gives,
+lane by lane, exactly the scalar function's results.
+"""
+import math
+
+from auvtrack._jit import njit, njit_noalloc
+
+
+@njit
+def helper(x, y):
+    """A called function with an early return."""
+    if x > y:
+        return x - y
+    return 0.25 * (y - x)
+
+
+@njit
+def branches(x, y):
+    """if / elif / else, nested ifs, an early return, a ternary, and/or/not, chained comparison."""
+    if x > y:
+        z = x - y
+        if z > 1.0:
+            return z * 2.0, 1
+    elif x < -y:
+        z = x + y
+    else:
+        z = 0.5
+    w = z if z > 0.0 else -z
+    flag = 1 if (x > 0.0 and y > 0.0) or not x < 2.0 else 0
+    if -1.0 < x <= 1.0:
+        w += helper(x, y)
+    return w + flag, 2
+
+
+@njit
+def loops(x, n):
+    """for with lane-dependent bounds, break, continue; while with a compound condition."""
+    s = 0.0
+    for i in range(n):
+        if i > 5 and x < 0.0:
+            break
+        if i % 3 == 1:
+            continue
+        s += x * i
+    k = 0
+    while s > 1.0 and k < 50:
+        s = s * 0.5
+        k += 1
+    return s, k
+
+
+@njit
+def return_in_loop(x, n):
+    """A return inside a loop (lanes leave at different iterations)."""
+    for i in range(n):
+        x = x * 1.5 - 0.3
+        if abs(x) > 10.0:
+            return x, i
+    return x, -1
+
+
+@njit_noalloc
+def stores(a, x):
+    """Masked stores and augmented stores into an array, a uniform loop."""
+    for i in range(a.shape[0]):
+        if x > i:
+            a[i] += x
+        else:
+            a[i] = -a[i]
+    return a[0] + a[a.shape[0] - 1]
+
+
+@njit
+def maths(x, p):
+    """Scalar maths per lane: exp, pow, tanh, min, max, int, floor, isfinite, division."""
+    ax = abs(x)
+    return (math.exp(-ax) + ax ** p + math.tanh(x), min(x, p), max(x, 2.0 * p), int(x), math.floor(x),
+            math.isfinite(x / p), x / (p + 3.0))
+
+
+CASES = {"branches": (branches, ("f", "f")), "loops": (loops, ("f", "i")),
+         "return_in_loop": (return_in_loop, ("f", "i")), "maths": (maths, ("f", "f"))}
+"""name -> (function, argument kinds: "f" float, "i" integer)."""
