@@ -1,4 +1,4 @@
-"""Command line: ``auvtrack reproduce | run | check | bounds | study | sweep | bench | warmup``.
+"""Command line: ``auvtrack reproduce | run | check | bounds | study | sweep | compare | bench | warmup``.
 
 Bad input (a scenario error, a missing file, an invalid gain, a run over the plan's limits, an
 output folder that cannot be written) prints ONE line to stderr and exits with status 2, never a
@@ -7,7 +7,7 @@ plan, controller set-up), so it refuses the same scenarios with the same message
 that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
 prints the diagnostic and exits 3.  Ctrl-C stops a run within about a second, saves what was
 computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps its
-completed chunks for ``--resume`` and exits 130.  ``auvtrack --help`` lists every command and
+completed chunks for ``--resume`` and exits 130 (so does ``compare``).  ``auvtrack --help`` lists every command and
 these exit codes.
 """
 from __future__ import annotations
@@ -65,9 +65,10 @@ EXIT_CODES = (("0", "success"),
               ("2", "bad input: one line naming the field and the allowed range, no traceback, nothing run"),
               ("3", "a simulation failed (diverged, pitch limit, envelope violated): the diagnostic is printed "
                     "and the partial result kept"),
-              ("130", "interrupted (Ctrl-C): a run keeps its partial result, a sweep its completed chunks"))
+              ("130", "interrupted (Ctrl-C): a run keeps its partial result, a sweep or a comparison its "
+                      "completed chunks"))
 EXIT_CODES_HELP = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + "."
-COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "study", "sweep", "bench", "warmup")
+COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "study", "sweep", "compare", "bench", "warmup")
 
 
 def _first_paragraph(text: str | None) -> str:
@@ -314,6 +315,80 @@ def sweep(study: str, out: str | None, workers: int | None, worker_memory: str, 
         click.echo(f"written: {folder / 'results.parquet'}, {folder / 'summary.json'}, {folder / 'summary.md'}")
     else:
         click.echo(f"stopped after {res.chunks_run} chunks; finish with: auvtrack sweep {study} --out {folder} --resume")
+
+
+def _split_names(values: tuple[str, ...]) -> list[str]:
+    return [n.strip() for v in values for n in v.split(",") if n.strip()]
+
+
+@cli.command(epilog=EXIT_CODES_HELP)
+@click.option("--suite", "suite_name", default="auv-track-v1", show_default=True, metavar="NAME",
+              help="A shipped suite (auvtrack/data/benchmarks/NAME.toml) or a suite TOML file.")
+@click.option("--controllers", "controllers", multiple=True, metavar="KIND[,KIND...]",
+              help="Built-in controllers to compare (repeatable or comma-separated; default: every registered "
+                   "tracking controller).")
+@click.option("--plugin", "plugins", multiple=True, type=click.Path(dir_okay=False), metavar="FILE.py",
+              help="Add a plug-in controller file to the comparison (repeatable); it enters under its file name.")
+@click.option("--quick", is_flag=True, help="CI-sized: every controller, task and tier, few seeds, short runs.")
+@click.option("--out", type=click.Path(file_okay=False), default=None,
+              help="Output folder (default compare/<suite>, compare/<suite>-quick with --quick).")
+@click.option("--scheduler", default=None, metavar="ADDRESS", help="Run on an existing Dask scheduler, tcp://host:port.")
+@click.option("--workers", type=int, default=None, help="Local threads (default: every core).")
+@click.option("--backend", default=None, metavar="NAME",
+              help="Back end of the batch runner (auvtrack.runner.batch.BACKENDS; default: its default).")
+@click.option("--resume", is_flag=True, help="Finish an interrupted comparison in --out (completed chunks are kept).")
+@click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, ...], quick: bool, out: str | None,
+            scheduler: str | None, workers: int | None, backend: str | None, resume: bool, max_chunks: int | None,
+            quiet: bool) -> None:
+    """Benchmark the controllers over a suite's tasks x tiers x seeds; write report.md/.html, results.json, runs.parquet.
+
+    Every registered tracking controller runs with its tuned gain preset ({kind}_tuned) or, without one, its
+    defaults; every controller sees the same seeds. Ranks, intervals and tests: docs/benchmark.md.
+    """
+    from .runner.batch import BatchInterrupted
+    from .runner.compare import CompareError
+    from .studies.benchmark import compare as _compare, default_out
+    from .studies.suite import SuiteError, load_suite
+
+    if workers is not None and scheduler:
+        raise BadInput("--workers and --scheduler exclude each other (the scheduler's cluster has its workers)")
+    if workers is not None and workers < 1:
+        raise BadInput(f"--workers: must be >= 1 (got {workers})")
+    try:
+        suite = load_suite(suite_name)
+    except SuiteError as exc:
+        raise BadInput(_one_line(exc)) from None
+    if quick:
+        suite = suite.quick_variant()
+    folder = Path(out) if out else default_out(suite)
+
+    def _stop(signum, frame):  # SIGTERM as Ctrl-C: stop cleanly, the finished chunks stay for --resume
+        raise KeyboardInterrupt
+
+    import signal
+
+    previous = signal.signal(signal.SIGTERM, _stop)
+    try:
+        res = _compare(suite, controllers=_split_names(controllers) or None, plugins=list(plugins), out=folder,
+                       scheduler=scheduler, workers=workers, backend=backend, resume=resume, max_chunks=max_chunks,
+                       progress=not quiet)
+    except (SuiteError, CompareError) as exc:
+        raise BadInput(_one_line(exc)) from None
+    except (BatchInterrupted, KeyboardInterrupt):
+        click.echo(f"auvtrack: interrupted; the finished chunks are kept: auvtrack compare --suite {suite_name}"
+                   f"{' --quick' if quick else ''} --out {folder} --resume", err=True)
+        raise click.exceptions.Exit(130)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    if not res.complete:
+        click.echo(f"stopped after {res.execution.chunks_run} chunks; finish with: auvtrack compare --suite "
+                   f"{suite_name}{' --quick' if quick else ''} --out {folder} --resume")
+        return
+    click.echo(f"runs: {res.execution.runs} in {res.execution.seconds:.1f} s (+ {res.analysis_seconds:.1f} s "
+               f"statistics and report)\nreport: {res.report}\nwritten: {folder / 'results.json'}, "
+               f"{folder / 'runs.parquet'}")
 
 
 @cli.command()

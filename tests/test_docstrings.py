@@ -46,6 +46,23 @@ API = [
     "auvtrack.studies.reproduce.reproduce",
     "auvtrack.studies.registry.all_studies",
     "auvtrack.studies.registry.get_study",
+    "auvtrack.studies.benchmark.compare",
+    "auvtrack.studies.suite.load_suite",
+    "auvtrack.studies.suite.resolve_controllers",
+    "auvtrack.studies.statistics.wilson_interval",
+    "auvtrack.studies.statistics.wilson_halfwidth_max",
+    "auvtrack.studies.statistics.bootstrap_median",
+    "auvtrack.studies.statistics.wilcoxon_test",
+    "auvtrack.studies.statistics.sign_test",
+    "auvtrack.studies.statistics.holm",
+    "auvtrack.studies.statistics.rank_biserial",
+    "auvtrack.studies.statistics.average_ranks",
+    "auvtrack.studies.leaderboard.score_table",
+    "auvtrack.studies.leaderboard.cell_statistics",
+    "auvtrack.studies.leaderboard.rank_bootstrap",
+    "auvtrack.studies.leaderboard.paired_comparisons",
+    "auvtrack.runner.compare.execute",
+    "auvtrack.runner.compare.run_chunk",
 ]
 
 

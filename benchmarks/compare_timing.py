@@ -1,0 +1,105 @@
+"""Wall time of ``auvtrack compare`` on this machine: ``--quick`` and the default suite, after compilation.
+
+Usage: ``python benchmarks/compare_timing.py [--skip-default] [--workers N] [--out DIR]``.
+
+A first ``--quick`` comparison compiles every kernel the disk cache lacks, or loads it, and is timed as
+"cold" (its compile/load column says which happened); then, in the
+same process, ``--quick`` and the default suite run again with everything compiled.  The numbers
+written to ``benchmarks/compare_timing.{json,md}`` are the reports' own timing blocks
+(``results.json`` -> ``timing``: runs, compilation, analysis, load averages) plus the wall time of
+each ``compare`` call.  The machine may be shared: the load averages are part of the result.
+Never used as a timed unit test.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import os
+import platform
+import tempfile
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from auvtrack import __version__
+from auvtrack.studies.benchmark import compare
+
+HERE = Path(__file__).resolve().parent
+TARGETS = {"quick (cold)": None, "quick": 120.0, "default": 900.0}  # s after compilation, issue 16
+
+
+def _one(label: str, out: Path, quick: bool, workers: int | None) -> dict:
+    t0 = time.perf_counter()
+    res = compare(quick=quick, out=out, workers=workers, progress=True)
+    wall = time.perf_counter() - t0
+    doc = json.loads((out / "results.json").read_text())
+    timing = doc["timing"]
+    after = timing["runs_seconds"] + timing["analysis_seconds"]
+    target = TARGETS[label]
+    runs = pd.read_parquet(out / "runs.parquet", columns=["task", "steps"])
+    dt_ = float(doc["suite"]["file"]["base"].get("sim.dt", 0.002))
+    full = runs["task"].map(lambda t: round(doc["suite"]["durations"][t] / dt_)).sum()
+    return {"variant": label, "out": str(out), "runs": timing["runs"], "seeds": doc["suite"]["seeds"],
+            "controllers": len(doc["controllers"]), "tiers": len(doc["suite"]["file"]["tiers"]) -
+            len(doc["suite"]["skipped_tiers"]), "wall_seconds": wall, "after_compilation_seconds": after,
+            "target_seconds": target, "meets_target": None if target is None else after <= target,
+            "steps": int(runs["steps"].sum()), "steps_full": int(full), "source_hash": doc["source_hash"], "complete": res.complete, **timing}
+
+
+def _cpu() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.system()
+
+
+def _markdown(doc: dict) -> str:
+    lines = ["# `auvtrack compare` wall time", "",
+             f"Written by `python benchmarks/compare_timing.py` at {doc['measured']} on {doc['machine']} "
+             f"({doc['cpu_count']} cores, a shared machine: see the load averages), auvtrack {doc['version']}, "
+             f"sources {doc['rows'][0]['source_hash'][:12]}.  \"After compilation\" = runs + statistics and "
+             "report (the `timing` block of each report's `results.json`); the cold row also compiles or loads "
+             "the kernels.", "",
+             "| variant | runs | runs (s) | compile/load (s) | statistics + report (s) | after compilation (s) "
+             "| target (s) | meets | RK4 steps flown / at full durations | load avg at start | load avg at end |",
+             "|" + "---|" * 11]
+    for r in doc["rows"]:
+        tgt = "" if r["target_seconds"] is None else f"{r['target_seconds']:.0f}"
+        ok = "" if r["meets_target"] is None else ("yes" if r["meets_target"] else "**no**")
+        la = "/".join(f"{x:.2f}" for x in r["load_average_start"] or [])
+        lb = "/".join(f"{x:.2f}" for x in r["load_average_end"] or [])
+        lines.append(f"| {r['variant']} | {r['runs']} | {r['runs_seconds']:.1f} | {r['compile_seconds']:.1f} | "
+                     f"{r['analysis_seconds']:.1f} | {r['after_compilation_seconds']:.1f} | {tgt} | {ok} | "
+                     f"{r['steps'] / r['steps_full']:.2f} | {la} | "
+                     f"{lb} |")
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    """Run the comparisons and write ``compare_timing.json`` and ``compare_timing.md`` next to this script."""
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--skip-default", action="store_true", help="only the --quick rows")
+    ap.add_argument("--workers", type=int, default=None, help="local threads (default: every core)")
+    ap.add_argument("--out", type=Path, default=None, help="folder of the comparisons (default: a new temp dir)")
+    args = ap.parse_args()
+    root = args.out or Path(tempfile.mkdtemp(prefix="auvtrack-compare-timing-"))
+    rows = [_one("quick (cold)", root / "quick-cold", True, args.workers),
+            _one("quick", root / "quick", True, args.workers)]
+    if not args.skip_default:
+        rows.append(_one("default", root / "default", False, args.workers))
+    doc = {"measured": dt.datetime.now(dt.timezone.utc).isoformat(timespec="minutes"),
+           "machine": f"{platform.machine()} / {_cpu()} / Python "
+                      f"{platform.python_version()}", "cpu_count": os.cpu_count(), "version": __version__,
+           "rows": rows}
+    (HERE / "compare_timing.json").write_text(json.dumps(doc, indent=2) + "\n")
+    (HERE / "compare_timing.md").write_text(_markdown(doc))
+    print(_markdown(doc))
+
+
+if __name__ == "__main__":
+    main()
