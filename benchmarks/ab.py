@@ -82,9 +82,13 @@ def main() -> None:
         print(f"{name}: min {t[0]:.2f}  p10 {t[len(t) // 10]:.2f}  median {statistics.median(t):.2f} ms per run")
     ratio = sorted(b / a for a, b in zip(*times))
     n = len(ratio)
-    same = metrics[0] == metrics[1]
+    common = sorted(set(metrics[0]) & set(metrics[1]))
+    differ = [k for k in common if metrics[0][k] != metrics[1][k]]
+    only = [sorted(set(m) - set(common)) for m in metrics]
     print(f"B / A: median {statistics.median(ratio):.3f} (quartiles {ratio[n // 4]:.3f}, {ratio[3 * n // 4]:.3f}); "
-          f"metrics bit-identical: {same}")
+          f"metrics bit-identical: {not differ and not any(only)}"
+          + (f"; the {len(common)} common metrics identical" if not differ else f"; differing: {differ}")
+          + "".join(f"; only in {t}: {o}" for t, o in zip("AB", only) if o))
 
 
 if __name__ == "__main__":
