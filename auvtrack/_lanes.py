@@ -168,7 +168,7 @@ def _vcall(builder, base, args, ret):
 
 
 def _lane(builder, value, k):
-    return builder.extract_element(value, _i32(k))
+    return builder.extract_element(value, _i32(k) if isinstance(k, int) else k)
 
 
 @lower_cast(types.Number, Lanes)
@@ -992,23 +992,72 @@ def _masked_typing(fn, typingctx, m, args):
                     else context.cast(builder, v, types.unliteral(t), s) for v, t, s in zip(vals, args, ssig.args)]
 
         vty = context.get_value_type(ret)
-        every = _vcall(builder, "llvm.vector.reduce.and", [mask], ir.IntType(1))
-        with builder.if_else(every, likely=True) as (all_on, some_off):
-            with all_on:  # the usual case: every lane, without a branch per lane
-                full = ir.Constant(vty, ir.Undefined)
-                for k in range(count):
-                    r = _scalar_cast(context, builder, impl(builder, lane_args(k)), ssig.return_type, ret.dtype)
-                    full = builder.insert_element(full, r, _i32(k))
-                bb_full = builder.block
-            with some_off:
-                part = _masked_lanes(context, builder, impl, mask, lane_args, ssig, ret, count)
-                bb_part = builder.block
+        first = _first_lane(builder, mask, count)
+        with builder.if_else(_same_in_active_lanes(builder, mask, first, vals, args)) as (uniform, varied):
+            with uniform:  # one call for every lane (a time or parameter shared by the runs of a block)
+                r = _scalar_cast(context, builder, impl(builder, lane_args(first)), ssig.return_type, ret.dtype)
+                one = _broadcast(builder, r, vty, count)
+                bb_one = builder.block
+            with varied:
+                every = _vcall(builder, "llvm.vector.reduce.and", [mask], ir.IntType(1))
+                with builder.if_else(every, likely=True) as (all_on, some_off):
+                    with all_on:  # every lane, without a branch per lane
+                        full = ir.Constant(vty, ir.Undefined)
+                        for k in range(count):
+                            r = _scalar_cast(context, builder, impl(builder, lane_args(k)), ssig.return_type,
+                                             ret.dtype)
+                            full = builder.insert_element(full, r, _i32(k))
+                        bb_full = builder.block
+                    with some_off:
+                        part = _masked_lanes(context, builder, impl, mask, lane_args, ssig, ret, count)
+                        bb_part = builder.block
+                each = builder.phi(vty)
+                each.add_incoming(full, bb_full)
+                each.add_incoming(part, bb_part)
+                bb_each = builder.block
         phi = builder.phi(vty)
-        phi.add_incoming(full, bb_full)
-        phi.add_incoming(part, bb_part)
+        phi.add_incoming(one, bb_one)
+        phi.add_incoming(each, bb_each)
         return phi
 
     return signature(ret, m, *args), codegen
+
+
+def _first_lane(builder, mask, count: int):
+    """i32 index of the first lane of ``mask`` (0 when the mask is empty)."""
+    bits = builder.zext(builder.bitcast(mask, ir.IntType(count)), ir.IntType(32))
+    fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(ir.IntType(32), [ir.IntType(32), ir.IntType(1)]),
+                                        "llvm.cttz.i32")
+    k = builder.call(fn, [builder.or_(bits, _i32(1 << count)), ir.Constant(ir.IntType(1), 0)])
+    return builder.select(builder.icmp_unsigned("<", k, _i32(count)), k, _i32(0))
+
+
+def _broadcast(builder, x, vty, count: int):
+    one = builder.insert_element(ir.Constant(vty, ir.Undefined), x, _i32(0))
+    return builder.shuffle_vector(one, one, ir.Constant(ir.VectorType(ir.IntType(32), count), [0] * count))
+
+
+def _same_in_active_lanes(builder, mask, first, vals, args):
+    """i1: in every lane of ``mask`` each lane argument has the bits it has in lane ``first`` (scalars
+    are the same in every lane by nature).  Then a function of the arguments is called once for all
+    of them: bit for bit each lane's own result."""
+    same = ir.Constant(ir.IntType(1), 1)
+    for v, t in zip(vals, args):
+        if not isinstance(t, Lanes):
+            continue
+        if isinstance(v.type.element, ir.DoubleType):
+            v = builder.bitcast(v, ir.VectorType(ir.IntType(64), t.count))
+        ref = _broadcast(builder, builder.extract_element(v, first), v.type, t.count)
+        eq = builder.icmp_unsigned("==", builder.select(mask, v, ref), ref)
+        same = builder.and_(same, _vcall(builder, "llvm.vector.reduce.and", [eq], ir.IntType(1)))
+    return same
+
+
+def _same_in_every_lane(builder, vals, args):
+    """i1: every lane argument holds lane 0's bits in every lane (scalars are the same by nature)."""
+    count = next(t.count for t in args if isinstance(t, Lanes)) if any(isinstance(t, Lanes) for t in args) else 1
+    full = ir.Constant(ir.VectorType(ir.IntType(1), count), [1] * count)
+    return _same_in_active_lanes(builder, full, _i32(0), vals, args)
 
 
 def _masked_lanes(context, builder, impl, mask, lane_args, ssig, ret, count):

@@ -120,40 +120,98 @@ def _lane_call(name: str, width: int):
     """Codegen of :func:`_vector_call` on lane values: entry k of every argument is one vector of L runs,
     evaluated 4 runs per call of ``name`` (the same 4-lane function, so each run gets the value it
     gets in a single run).  The calls are declared without side effects, so an entry whose result
-    is unused (the padding of ``(x, y, z, 1.0)``) is removed by LLVM."""
+    is unused (the padding of ``(x, y, z, 1.0)``) is removed by LLVM.
+
+    When every lane holds the same bits in every entry (a time and parameters shared by the runs
+    of a block: the paper's disturbance), the entries of lane 0 take the single run's own call
+    (``width / 4`` calls in all) and every lane gets its result: the same bits, as the functions
+    are elementwise.
+    """
     from llvmlite import ir
 
-    from ._lanes import Lanes, _splat
+    from ._lanes import Lanes, _same_in_every_lane, _splat
 
     def codegen(context, builder, signature, args):
         rty = signature.return_type.types[0]
         L = rty.count
+        lt = Lanes(types.float64, L)
         wide = WIDE.get(name) if L % 8 == 0 else None
         w = 8 if wide else 4
         vw = ir.VectorType(ir.DoubleType(), w)
         fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(vw, [vw] * len(args)), wide or name)
         fn.attributes.add("nounwind")
         fn.attributes.add("readnone")
+        entries = [[(builder.extract_value(a, k), aty.types[k]) for a, aty in zip(args, signature.args)]
+                   for k in range(width)]
+        lane_vals = [v for e in entries for v, t in e if isinstance(t, Lanes)]
+        same = _same_in_every_lane(builder, lane_vals, [lt] * len(lane_vals))
+        with builder.if_else(same) as (uniform, varied):
+            with uniform:
+                outs_u = _uniform_entries(context, builder, name, entries, len(args), L)
+                bb_u = builder.block
+            with varied:
+                outs_v = []
+                for e in entries:
+                    vecs = [_splat(context, builder, v, t, lt) for v, t in e]
+                    outs_v.append(_chunked_call(builder, fn, vecs, w, L))
+                bb_v = builder.block
         outs = []
-        for k in range(width):
-            vecs = [_splat(context, builder, builder.extract_value(a, k), aty.types[k], Lanes(types.float64, L))
-                    for a, aty in zip(args, signature.args)]
-            res = None
-            for c in range(L // w):
-                idx = ir.Constant(ir.VectorType(ir.IntType(32), w), list(range(w * c, w * c + w)))
-                r = builder.call(fn, [builder.shuffle_vector(v, v, idx) for v in vecs])
-                if res is None:
-                    res = r
-                else:  # concatenate: [res, r] (res covers w c lanes)
-                    n = w * c
-                    r_wide = builder.shuffle_vector(r, r, ir.Constant(ir.VectorType(ir.IntType(32), n),
-                                                                         [i % w for i in range(n)]))
-                    res = builder.shuffle_vector(res, r_wide, ir.Constant(ir.VectorType(ir.IntType(32), n + w),
-                                                                             list(range(n)) + list(range(n, n + w))))
-            outs.append(res)
+        for u, v in zip(outs_u, outs_v):
+            phi = builder.phi(u.type)
+            phi.add_incoming(u, bb_u)
+            phi.add_incoming(v, bb_v)
+            outs.append(phi)
         return context.make_tuple(builder, signature.return_type, outs)
 
     return codegen
+
+
+def _chunked_call(builder, fn, vecs, w: int, L: int):
+    """``fn`` (w lanes) on L-lane vectors, w lanes per call, the results concatenated."""
+    from llvmlite import ir
+
+    res = None
+    for c in range(L // w):
+        idx = ir.Constant(ir.VectorType(ir.IntType(32), w), list(range(w * c, w * c + w)))
+        r = builder.call(fn, [builder.shuffle_vector(v, v, idx) for v in vecs])
+        if res is None:
+            res = r
+        else:  # concatenate: [res, r] (res covers w c lanes)
+            n = w * c
+            r_wide = builder.shuffle_vector(r, r, ir.Constant(ir.VectorType(ir.IntType(32), n),
+                                                                 [i % w for i in range(n)]))
+            res = builder.shuffle_vector(res, r_wide, ir.Constant(ir.VectorType(ir.IntType(32), n + w),
+                                                                     list(range(n)) + list(range(n, n + w))))
+    return res
+
+
+def _uniform_entries(context, builder, name: str, entries, nargs: int, L: int):
+    """The single run's call of the 4-lane ``name`` on lane 0 of each entry, each result broadcast to L lanes."""
+    from llvmlite import ir
+
+    from ._lanes import Lanes
+
+    v4 = ir.VectorType(ir.DoubleType(), 4)
+    fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(v4, [v4] * nargs), name)
+    fn.attributes.add("nounwind")
+    fn.attributes.add("readnone")
+    zero = ir.Constant(ir.IntType(32), 0)
+    firsts = [[builder.extract_element(v, zero) if isinstance(t, Lanes)
+               else context.cast(builder, v, types.unliteral(t), types.float64) for v, t in e] for e in entries]
+    outs = []
+    for part in range(len(entries) // 4):
+        vecs = []
+        for j in range(nargs):
+            vec = ir.Constant(v4, ir.Undefined)
+            for k in range(4):
+                vec = builder.insert_element(vec, firsts[4 * part + k][j], ir.Constant(ir.IntType(32), k))
+            vecs.append(vec)
+        r = builder.call(fn, vecs)
+        for k in range(4):
+            x = builder.extract_element(r, ir.Constant(ir.IntType(32), k))
+            one = builder.insert_element(ir.Constant(ir.VectorType(ir.DoubleType(), L), ir.Undefined), x, zero)
+            outs.append(builder.shuffle_vector(one, one, ir.Constant(ir.VectorType(ir.IntType(32), L), [0] * L)))
+    return outs
 
 
 def _vector_call(name: str, width: int, nargs: int, parts: int = 1):

@@ -6,6 +6,7 @@ lane by lane, exactly the scalar function's results.
 import math
 
 from auvtrack._jit import njit, njit_noalloc
+from auvtrack._vecmath import atanh4, exp8, pow4, sincos4
 
 
 @njit
@@ -80,6 +81,23 @@ def maths(x, p):
             math.isfinite(x / p), x / (p + 3.0))
 
 
+@njit
+def shared(x, p):
+    """Scalar and vector libm calls, in branches (partial masks) and outside: the calls a lane form
+    makes once when the lanes' arguments have the same bits."""
+    r = 0.0
+    if x > 0.25:
+        r = math.sin(x) + math.cos(p) + abs(x) ** p
+    else:
+        r = math.atan2(x, p) + math.exp(x)
+    s, c = sincos4((x, p, 0.0, 0.0))
+    q = pow4((abs(x), abs(p) + 0.5, 2.0, 1.0), (p, p, p, p))
+    z = atanh4((x / (abs(x) + 1.0), 0.5 * math.tanh(p), 0.0, 0.0))
+    e = exp8((x, p, -x, -p, 0.0, 0.0, 0.0, 0.0))
+    return r, s[0] + c[1], s[1] - c[0], q[0] + q[1], q[2], z[0] + z[1], e[0] + e[1] - e[2] * e[3]
+
+
 CASES = {"branches": (branches, ("f", "f")), "loops": (loops, ("f", "i")),
-         "return_in_loop": (return_in_loop, ("f", "i")), "maths": (maths, ("f", "f"))}
+         "return_in_loop": (return_in_loop, ("f", "i")), "maths": (maths, ("f", "f")),
+         "shared": (shared, ("f", "f"))}
 """name -> (function, argument kinds: "f" float, "i" integer)."""

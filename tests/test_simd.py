@@ -37,7 +37,7 @@ PAPER = paper_scenario_path()
 
 # ------------------------------------------------------------------ the rewrite, construct by construct
 
-N_OUT = {"branches": 2, "loops": 2, "return_in_loop": 2, "maths": 7}
+N_OUT = {"branches": 2, "loops": 2, "return_in_loop": 2, "maths": 7, "shared": 7}
 
 
 def _driver(fn, kinds):
@@ -87,6 +87,25 @@ def test_lane_form_equals_the_scalar_function_lane_by_lane(name, data):
     for lane in range(L):
         want = np.array(fn(*[vals[i][lane] for i in range(len(kinds))]), dtype=float)
         np.testing.assert_array_equal(got[lane], want, err_msg=f"lane {lane} of {name}")
+
+
+# a few values, signed zeros among them, so that lanes often share the bits of their arguments
+_pool = st.lists(st.sampled_from([0.0, -0.0, 0.3, -0.7, 1.5, 2.0, 1e-300]) | floats, min_size=1, max_size=3)
+
+
+@settings(max_examples=60)
+@given(data=st.data())
+def test_calls_shared_by_lanes_give_each_lane_its_own_result(data):
+    """A libm or vector-libm call whose arguments have the same bits in every active lane is made once
+    (auvtrack._lanes, auvtrack._vecmath): each lane still gets the scalar function's result bit for
+    bit, with the lanes of a branch all alike, alike but for a signed zero, or mixed."""
+    fn, kinds = lane_cases.CASES["shared"]
+    xs, ps = data.draw(_pool), data.draw(_pool)
+    F = np.array([[data.draw(st.sampled_from(xs)) for _ in range(L)], [data.draw(st.sampled_from(ps)) for _ in range(L)]])
+    got = _lanes_of("shared", F, np.zeros((2, L), dtype=np.int64))
+    for lane in range(L):
+        want = np.array(fn(F[0, lane], F[1, lane]), dtype=float)
+        assert got[lane].tobytes() == want.tobytes(), f"lane {lane}: {got[lane]} != {want}"
 
 
 def test_masked_stores_keep_the_other_lanes():
