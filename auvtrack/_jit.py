@@ -4,7 +4,8 @@ Numba's on-disk cache is keyed by the timestamp of the file that defines a funct
 files it calls, so editing ``plant/dynamics.py`` would leave a stale cached ``simulation/engine.py``
 kernel.  We therefore place the cache in a directory named by a hash of *all* package sources:
 any source change selects a fresh directory.  The name also carries the vector-math back end of
-:mod:`auvtrack._vecmath` (compiled code differs between them).  Set ``AUVTRACK_CACHE_DIR`` to
+:mod:`auvtrack._vecmath` and whether the lane kernels use its 8-lane AVX-512 functions (compiled code
+differs between them).  Set ``AUVTRACK_CACHE_DIR`` to
 override the root.
 """
 from __future__ import annotations
@@ -40,7 +41,8 @@ def source_hash() -> str:
 def cache_dir() -> Path:
     """Return the numba cache directory for the current package sources."""
     root = Path(os.environ.get("AUVTRACK_CACHE_DIR", Path.home() / ".cache" / "auvtrack"))
-    return root / f"numba-{numba.__version__}-{source_hash()[:16]}-{_vecmath.BACKEND}"
+    wide = "-avx512" if _vecmath.WIDE else ""  # the lane kernels' 8-lane libmvec calls (AUVTRACK_LIBMVEC_AVX512)
+    return root / f"numba-{numba.__version__}-{source_hash()[:16]}-{_vecmath.BACKEND}{wide}"
 
 
 numba.config.CACHE_DIR = str(cache_dir())

@@ -67,7 +67,20 @@ def test_backend_is_vector_where_libmvec_exists():
 
 
 def test_cache_directory_names_the_backend():
-    assert _jit.cache_dir().name.endswith("-" + _vecmath.BACKEND)
+    assert _jit.cache_dir().name.endswith("-" + _vecmath.BACKEND + ("-avx512" if _vecmath.WIDE else ""))
+
+
+def test_the_lane_kernels_8_lane_calls_select_another_cache_directory():
+    """AUVTRACK_LIBMVEC_AVX512=0 changes the lane kernels' code (4-lane calls only), so their cache too."""
+    code = "import auvtrack._vecmath as v, auvtrack._jit as j; print(len(v.WIDE), j.cache_dir().name)"
+    names = {}
+    for flag in ("0", "1"):
+        out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "AUVTRACK_LIBMVEC_AVX512": flag},
+                             capture_output=True, text=True, check=True).stdout.split()
+        names[flag] = (int(out[0]), out[1])
+    assert names["0"][0] == 0 and not names["0"][1].endswith("-avx512")
+    assert names["1"][1].endswith("-avx512") == (names["1"][0] > 0)
+    assert (names["0"][1] != names["1"][1]) == (names["1"][0] > 0)
 
 
 def test_libmvec_can_be_switched_off():
@@ -75,7 +88,7 @@ def test_libmvec_can_be_switched_off():
     code = "import auvtrack._vecmath as v, auvtrack._jit as j; print(v.BACKEND, j.cache_dir().name)"
     out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "AUVTRACK_LIBMVEC": "0"},
                          capture_output=True, text=True, check=True).stdout.split()
-    assert out[0] == "scalar" and out[1].endswith("-scalar")
+    assert out[0] == "scalar" and out[1].endswith("-scalar")  # (no 8-lane calls without libmvec)
 
 
 @settings(max_examples=60, deadline=None)

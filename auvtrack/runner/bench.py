@@ -237,7 +237,7 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
 
     Time to the first result with an empty kernel cache (a cold ``auvtrack run`` and a cold
     ``auvtrack warmup``, each in a new process), single-run µs per RK4 step for every controller,
-    batch runs/s (10 s runs at dt = 1 ms) and efficiency per back end, and sweep throughput on 1
+    batch runs/s (runs as long as the single runs, at dt = 1 ms) and efficiency per back end, and sweep throughput on 1
     and 2 Dask workers (see :mod:`auvtrack.runner.sweep_bench`).  ``out`` defaults to a new user folder
     (:func:`user_bench_folder`), so running the suite from a clone leaves the working tree
     unchanged; pass ``out=Path("benchmarks")`` to update the record kept in the repository.
@@ -256,8 +256,8 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     dict
         The record written to ``results.json``, plus ``"out"``: the folder (not written).
     """
-    from .sweep_bench import (bench_batch, bench_breakdown, bench_cold_start, bench_cold_warmup, bench_sweep,
-                              write_results)
+    from .sweep_bench import (RUN_SECONDS, bench_batch, bench_breakdown, bench_cold_start, bench_cold_warmup,
+                              bench_sweep, write_results)
 
     say = print if progress else (lambda *a, **k: None)
     mach = machine()  # load average before our own runs
@@ -268,7 +268,7 @@ def bench_all(*, repeat: int = 7, out: Path | None = None, progress: bool = Fals
     folder = _jit.cache_dir() / "bench_plugins"  # a fixed place: the plug-in kernels stay cached
     folder.mkdir(parents=True, exist_ok=True)
     copies = tuple(f"plugin:{plugin_copy(k, folder)}" for k in ("ftsmc", "fxtntsmc"))  # the paper's laws as plug-ins
-    single = bench_singles(builtin_controllers() + copies, repeat=3 * repeat, duration=20.0)
+    single = bench_singles(builtin_controllers() + copies, repeat=3 * repeat, duration=RUN_SECONDS)
     for row in single:
         if row["controller"].startswith("plugin:"):
             row["controller"] = Path(row["controller"]).stem.replace("copy_of_", "") + " (plug-in copy)"
