@@ -6,7 +6,8 @@
 * whole runs: metrics to 1e-9 relative (in fact bit for bit, asserted separately), failure cause,
   time and state, steps, for batches with runs that fail at different times, of different lengths,
   of several controllers, sampled-data and continuous;
-* a law the rewrite cannot handle runs on the thread back end instead, with the same results;
+* a law the rewrite cannot handle, or whose lane form Numba cannot type, runs on the thread back
+  end instead, with the same results;
 * a stop request reaches every lane.
 """
 from __future__ import annotations
@@ -303,6 +304,31 @@ def test_a_law_without_lane_form_runs_on_threads(tmp_path):
             for i in range(max(MIN_LANES, 2))]  # enough runs for a block
     preps = [dataclasses.replace(p, key=kernels.KernelKey(str(law), p.key.plant, "plug-in on 5dof")) for p in base]
     with pytest.warns(UserWarning, match="no lane form"):
+        out = run_batch(preps, backend="simd", workers=2)
+    for s, p in zip(out, base):
+        _same_run(s, run_prepared(p), bitwise=True)
+
+
+def test_a_lane_form_numba_cannot_type_runs_on_threads(tmp_path):
+    """A law the rewrite handles but whose lane form does not type (a libm function with no lane
+    implementation): found when the group is set up, warned about, run on threads; same results."""
+    law = tmp_path / "gamma_law.py"
+    law.write_text(textwrap.dedent('''
+        import math
+        from auvtrack._jit import njit
+        from auvtrack.control.ftsmc import control as ftsmc_control
+
+        @njit
+        def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+            g = math.gamma(2.0 + min(abs(eta[0]), 1.0))  # finite: g - g = 0
+            return ftsmc_control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work) + int(g - g)
+    '''))
+    base = [prepare(load_scenario(PAPER, {"controller.kind": "ftsmc", "seed": i, "sim.duration": 0.2}))
+            for i in range(L)]
+    preps = [dataclasses.replace(p, key=kernels.KernelKey(str(law), p.key.plant, "gamma plug-in on 5dof"))
+             for p in base]
+    kernels.lanes_module(preps[0].key)  # the rewrite itself succeeds
+    with pytest.warns(UserWarning, match="gamma plug-in on 5dof has no lane form"):
         out = run_batch(preps, backend="simd", workers=2)
     for s, p in zip(out, base):
         _same_run(s, run_prepared(p), bitwise=True)

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
+from numba.core.errors import NumbaError
 
 from ..simulation import engine, kernels
 from ..simulation.api import (Prepared, call_kernel, ensure_compiled, failure_record, outputs_for, result_from,
@@ -269,6 +270,10 @@ class _LaneGroup:
                      _lane_stack([p.si for p in ps], L), _lane_stack([p.sf for p in ps], L), logs, self.accs,
                      self.fails, self.infos, counts, self.causes, self.t_stops)
 
+    def compile(self) -> None:
+        """Type and compile (or load) the lane kernel for these arguments: a call over no block."""
+        self.module.run_lanes(*self.args, 0, 0)
+
     def run_block(self, b: int) -> None:
         """Run block ``b`` (the kernel releases the GIL)."""
         self.module.run_lanes(*self.args, b, b + 1)
@@ -288,7 +293,8 @@ def _run_simd(preps: Sequence[Prepared], stop: StopSignal, workers: int) -> list
     Within a group, runs are sorted by length so that a block's lanes end together; the blocks, and
     the runs that go to the single-run kernel (fewer than :data:`MIN_LANES` left over in a group, or
     a group whose law or plant has no lane form, :class:`~auvtrack.simulation.lanes.NotLaneable`,
-    which is warned about) are spread over ``workers`` threads.
+    or one whose lane form Numba cannot type or compile, which is warned about) are spread over
+    ``workers`` threads.
     """
     from ..simulation.lanes import NotLaneable
 
@@ -308,14 +314,16 @@ def _run_simd(preps: Sequence[Prepared], stop: StopSignal, workers: int) -> list
         if not idx:
             continue
         try:
-            module = kernels.lanes_module(preps[idx[0]].key)
-        except NotLaneable as exc:
+            group = _LaneGroup(kernels.lanes_module(preps[idx[0]].key), [preps[i] for i in idx], stop)
+            group.compile()  # here, once, before the threads: a lane form Numba cannot type is found now
+        except (NotLaneable, NumbaError) as exc:
             key = preps[idx[0]].key
-            warnings.warn(f"simd back end: {key.label or key.name} has no lane form ({exc}); "
+            why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            warnings.warn(f"simd back end: {key.label or key.name} has no lane form ({why}); "
                           "its runs use the thread back end", stacklevel=3)
             singles += idx
             continue
-        lane_groups.append((idx, _LaneGroup(module, [preps[i] for i in idx], stop)))
+        lane_groups.append((idx, group))
     tasks: list[Callable[[], Any]] = [lambda g=g, b=b: g.run_block(b) for _, g in lane_groups for b in range(g.nb)]
     tasks += [lambda i=i: out.__setitem__(i, run_metrics(preps[i], stop)) for i in singles]
     if workers == 1 or len(tasks) == 1:
