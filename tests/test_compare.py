@@ -160,6 +160,39 @@ def test_quick_path_numbers_are_the_runs_numbers(quick):
     assert json.loads(row.draws) == pytest.approx(drawn)
 
 
+def test_simd_back_end_compiles_its_lane_kernels_before_the_timed_runs(tiny, tmp_path, monkeypatch):
+    """With ``backend="simd"`` the warm-up flies a full block of lanes per signature, so no lane kernel
+    compiles inside the timed runs; the numbers are those of the thread back end."""
+    from auvtrack.runner import batch as batch_mod
+
+    timed = {"on": False, "compiled_while_timed": [], "warm": set(), "timed": set()}
+    real = batch_mod._LaneGroup.compile
+
+    def watch(self):
+        before = len(self.module.run_lanes.signatures)
+        real(self)
+        timed["timed" if timed["on"] else "warm"].add(self.ps[0].key.name)
+        if timed["on"] and len(self.module.run_lanes.signatures) > before:
+            timed["compiled_while_timed"].append(self.ps[0].key.name)
+
+    real_warm = runner._warm
+
+    def warm_then_time(*a, **k):
+        out = real_warm(*a, **k)
+        timed["on"] = True
+        return out
+
+    monkeypatch.setattr(batch_mod._LaneGroup, "compile", watch)
+    monkeypatch.setattr(runner, "_warm", warm_then_time)
+    a = compare(tiny, controllers=["ftsmc"], out=tmp_path / "simd", progress=False, backend="simd")
+    assert timed["on"] and timed["compiled_while_timed"] == []
+    assert timed["timed"] and timed["timed"] <= timed["warm"]  # every lane kernel the runs used was set up in the warm-up
+    b = compare(tiny, controllers=["ftsmc"], out=tmp_path / "threads", progress=False, backend="threads")
+    assert a.complete and b.complete
+    pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "simd" / "runs.parquet"),
+                                  pd.read_parquet(tmp_path / "threads" / "runs.parquet"))
+
+
 def test_same_suite_same_seeds_identical_numbers(tiny, tmp_path):
     a = compare(tiny, out=tmp_path / "a", progress=False)
     b = compare(tiny, out=tmp_path / "b", progress=False, chunk_size=5, backend="serial")  # nor chunks, back end

@@ -267,7 +267,8 @@ def _warm(specs: Sequence[RunSpec], workers: int | None = None, backend: str | N
     One run per (controller, tier, plant preset) is prepared (set-up helpers compile on first
     use), its kernel compiled or loaded, and then flown for 0.5 s: a kernel compiles one
     specialisation per type signature of its bundles, and the tiers' bundles differ, so this
-    loads every signature the runs will call.
+    loads every signature the runs will call.  With the ``simd`` back end each is flown in a full
+    block of lanes, so that the lane kernels too compile here.
     """
     from ..simulation.api import ensure_compiled
     from .batch import run_batch
@@ -285,7 +286,12 @@ def _warm(specs: Sequence[RunSpec], workers: int | None = None, backend: str | N
                 seen[key] = p
     ensure_compiled(list(seen.values()), progress=True)
     if seen:
-        run_batch(list(seen.values()), workers=workers, **_backend_kw(backend))
+        warm = list(seen.values())
+        if backend == "simd":  # a block of lanes per signature: the lane kernels compile here, not in the timed runs
+            from ..simulation.engine import LANES
+
+            warm = [p for p in warm for _ in range(LANES)]
+        run_batch(warm, workers=workers, **_backend_kw(backend))
     return time.perf_counter() - t0
 
 
