@@ -251,7 +251,8 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
 @cli.command()
 @click.option("--controller", "controllers", multiple=True, help="Controller kind(s) (default: every one).")
 @click.option("--plant", "plants", multiple=True, help="Plant model(s) (default: every one).")
-def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
+@click.option("--simd", is_flag=True, help="Also compile the SIMD batch kernels (`--backend simd`; a few times longer).")
+def warmup(controllers: tuple[str, ...], plants: tuple[str, ...], simd: bool) -> None:
     """Compile every kernel (each controller on each plant) once, in parallel; later runs load them.
 
     The first command after installing or editing the package compiles the kernels it needs
@@ -259,7 +260,7 @@ def warmup(controllers: tuple[str, ...], plants: tuple[str, ...]) -> None:
     """
     from .runner.bench import warmup as _warmup
 
-    click.echo(json.dumps(_warmup(controllers, plants, progress=True)))
+    click.echo(json.dumps(_warmup(controllers, plants, progress=True, simd=simd)))
 
 
 @cli.command(epilog=EXIT_CODES_HELP)

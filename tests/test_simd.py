@@ -356,6 +356,23 @@ def test_lane_kernel_lives_next_to_its_kernel_in_the_keyed_cache():
     assert math.isfinite(len(kernels.lanes_source(key)))
 
 
+def test_warmup_compiles_the_lane_kernel_a_simd_batch_then_uses():
+    """``compile_lanes`` compiles run_lanes for exactly the types the SIMD back end passes: a batch
+    afterwards compiles nothing; ``warmup(..., lanes=True)`` marks it on disk, ``lanes_compiled``."""
+    preps = [prepare(load_scenario(PAPER, {"controller.kind": "pid", "seed": i, "sim.duration": 0.05}))
+             for i in range(L)]
+    key = preps[0].key
+    assert kernels.compile_lanes(key) and kernels.lanes_compiled(key)
+    run_lanes = kernels.lanes_module(key).run_lanes
+    before = list(run_lanes.signatures)
+    assert len(before) == 1
+    out = run_batch(preps, backend="simd", workers=1)
+    assert list(run_lanes.signatures) == before
+    for s, p in zip(out, preps):
+        _same_run(s, run_prepared(p), bitwise=True)
+    assert kernels.warmup([key], lanes=True) == []  # nothing left to compile
+
+
 def test_a_few_runs_left_over_use_the_single_run_kernel():
     """L + 1 runs: one block of L in lanes, the one left over on the single-run kernel; same results."""
     preps = [prepare(load_scenario(PAPER, {"controller.kind": "ftsmc", "seed": i, "sim.duration": 0.1}))

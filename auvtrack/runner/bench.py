@@ -180,7 +180,8 @@ def bench_singles(kinds: tuple[str, ...], *, repeat: int = 7, duration: float = 
     return rows
 
 
-def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, progress: bool = False) -> dict:
+def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, progress: bool = False,
+           simd: bool = False) -> dict:
     """Compile (or load from the on-disk cache) the kernel of every controller on every plant.
 
     Kernels that are not cached compile in parallel, one process per core
@@ -194,6 +195,9 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
         :func:`builtin_pairs`; a 6-DOF plant's kernels one per preset module).
     progress : bool, optional
         Show a progress bar while compiling.
+    simd : bool, optional
+        Also compile each pair's SIMD batch kernel (``run_batch(..., backend="simd")``), which
+        otherwise compiles on first use.
 
     Returns
     -------
@@ -205,7 +209,7 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
 
     keys = kernel_keys(builtin_pairs(controllers, plants))
     t0 = time.perf_counter()
-    done = kernels.warmup(keys, progress=progress)
+    done = kernels.warmup(keys, progress=progress, lanes=simd)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
             "seconds": round(time.perf_counter() - t0, 2)}
 

@@ -188,6 +188,15 @@ def batch_cpu_efficiency(row: dict, cpu_us_per_step: float, dt: float = 0.001) -
     return steps * cpu_us_per_step * 1e-3 / row["cpu_ms_per_run"]
 
 
+def simd_over_serial(batch: dict, kind: str) -> float:
+    """CPU time per run of the ``serial`` back end over that of ``simd``, on the same metrics-only runs.
+
+    ``batch`` maps (controller, back end) to a :func:`bench_batch` row.  Unlike the efficiencies,
+    which divide by the single run (that also records a trajectory), this compares like with like.
+    """
+    return batch[(kind, "serial")]["cpu_ms_per_run"] / batch[(kind, "simd")]["cpu_ms_per_run"]
+
+
 def bench_cold_start(*, duration: float = 1.0) -> dict:
     """Wall time of ``auvtrack run`` of the Section 4 scenario in a new process with an empty kernel cache.
 
@@ -242,6 +251,7 @@ def write_results(doc: dict, out: Path) -> None:
     (out / "results.json").write_text(json.dumps(doc, indent=2))
     m = doc["machine"]
     single = {r["controller"]: r for r in doc["single"]}
+    batch = {(r["controller"], r["backend"]): r for r in doc["batch"]}
     lines = ["# Benchmark results", "",
              f"Measured {doc['date']} with `auvtrack bench --all` on {m['cpu']}, {m['cores']} cores, "
              f"Python {m['python']}, Numba {m['numba']}, vector math {m.get('vector_math', 'scalar')} "
@@ -303,7 +313,10 @@ def write_results(doc: dict, out: Path) -> None:
               + f"{r['prepare_ms_per_run']:.2f} | {r['load_avg_1min']} |" for r in doc["batch"]]
     lines += ["", "CPU efficiency: the single run's CPU time per run (table above) over the batch's "
               "process CPU time per run; unlike the wall-time efficiency it does not drop when other processes "
-              "take the cores."]
+              "take the cores.  The single run also records its trajectory, which the batch does not; like with "
+              "like, the `serial` back end's CPU time per run over the `simd` back end's on the same runs is "
+              + ", ".join(f"{k} {simd_over_serial(batch, k):.2f}" for k in sorted({r['controller'] for r in doc['batch']}))
+              + "."]
     lines += ["", "## Sweep on Dask distributed (LocalCluster, processes, 1 thread each)", "",
               f"{doc['sweep'][0]['samples']} samples of {doc['sweep'][0]['run_seconds']:g} s (half FTSMC, half "
               "FXTNTSMC, chunks of 10), including per-sample scenario validation and preparation and the "

@@ -37,6 +37,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
+import numpy as np
+
 from .. import _jit
 from . import engine
 
@@ -365,16 +367,78 @@ def _compile_run(run) -> None:
     run.compile(tuple(numba.typeof(a) for a in engine.example_arguments()))
 
 
-def _compile_in_process(key: KernelKey) -> float:
+def example_lane_arguments() -> tuple:
+    """Arguments of a lanes module's ``run_lanes`` with the types the SIMD back end passes, over no block.
+
+    Each run's arrays stacked in blocks of :data:`~auvtrack.simulation.engine.LANES` along a last
+    axis (``auvtrack.runner.batch._LaneGroup``): C-contiguous float64, int64 for ``si``, ``infos``,
+    ``counts`` and ``causes``; ``b0 = b1 = 0``, so a call compiles (or loads) and runs nothing.
+    """
+    L = engine.LANES
+    f3, f4, i3 = np.zeros((1, 1, L)), np.zeros((1, 1, 1, L)), np.zeros((1, 1, L), np.int64)
+    return (f3, f3, f3, f3, f3, f4, f4, f4, f3, i3, f3, f4, f3, f4, i3, np.zeros(1, np.int64),
+            np.zeros((1, L), np.int64), np.zeros((1, L)), 0, 0)
+
+
+def _lanes_marker(key: KernelKey) -> Path:
+    return _folder() / f"{key.name}.lanes.json"
+
+
+def lanes_compiled(key: KernelKey) -> bool:
+    """True when the SIMD batch kernel of ``key`` has been compiled into the on-disk cache.
+
+    Parameters
+    ----------
+    key : KernelKey
+        The pair.
+
+    Returns
+    -------
+    bool
+        Whether its first SIMD batch needs no compilation.
+    """
+    return _lanes_marker(key).is_file()
+
+
+def compile_lanes(key: KernelKey) -> bool:
+    """Compile (or load) the SIMD batch kernel of ``key`` for the types the batch runner passes.
+
+    Parameters
+    ----------
+    key : KernelKey
+        The pair.
+
+    Returns
+    -------
+    bool
+        False when the pair has no lane form (the SIMD back end then runs it on threads).
+    """
+    from numba.core.errors import NumbaError
+
+    from .lanes import NotLaneable
+
     t0 = time.perf_counter()
-    _compile_run(kernel(key))
-    seconds = time.perf_counter() - t0
-    mark_compiled(key, seconds)
-    return seconds
+    try:
+        lanes_module(key).run_lanes(*example_lane_arguments())
+    except (NotLaneable, NumbaError):
+        return False
+    _write_if_changed(_lanes_marker(key), json.dumps({"kernel": key.name, "seconds": round(time.perf_counter() - t0, 2)}))
+    return True
+
+
+def _compile_in_process(key: KernelKey, lanes: bool = False) -> float:
+    t0 = time.perf_counter()
+    if not is_compiled(key):
+        _compile_run(kernel(key))
+        mark_compiled(key, time.perf_counter() - t0)
+    if lanes and not lanes_compiled(key):
+        compile_lanes(key)
+    return time.perf_counter() - t0
 
 
 def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
-           notice: Callable[[str], None] | None = None, progress: bool = False) -> list[KernelKey]:
+           notice: Callable[[str], None] | None = None, progress: bool = False,
+           lanes: bool = False) -> list[KernelKey]:
     """Compile the kernels of ``keys`` that are not cached yet, several at once, and load them.
 
     One missing kernel compiles in this process; several compile in ``jobs`` child processes (Numba
@@ -392,6 +456,9 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
         Receives the one-line "compiling kernels ..." notice (default: printed to stderr).
     progress : bool, optional
         Show a progress bar over the kernels being compiled.
+    lanes : bool, optional
+        Also compile each pair's SIMD batch kernel (:func:`compile_lanes`); otherwise it compiles
+        on the first ``simd`` batch that needs it.
 
     Returns
     -------
@@ -400,7 +467,7 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
     """
     todo = []
     for k in dict.fromkeys(keys):  # each key once, in order
-        if not is_compiled(k):
+        if not is_compiled(k) or (lanes and not lanes_compiled(k)):
             todo.append(k)
     if not todo:
         return []
@@ -409,17 +476,18 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
     waves = -(-len(todo) // max(1, jobs))
     say = notice or (lambda text: print(text, file=sys.stderr, flush=True))
     names = ", ".join(k.label or k.name for k in todo)
-    say(f"compiling kernels (first run only, about {per * waves:.0f} s): {names}")
+    what = "kernels and their SIMD batch forms" if lanes else "kernels"
+    say(f"compiling {what} (first run only, about {per * waves * (3 if lanes else 1):.0f} s): {names}")
     bar = _bar(len(todo), progress)
     try:
         if len(todo) == 1 or jobs == 1:
             for k in todo:
-                _compile_in_process(k)
+                _compile_in_process(k, lanes)
                 bar.update(1)
         else:
             shares = _shares(todo, jobs)
             with ThreadPoolExecutor(max_workers=len(shares)) as pool:
-                for f in [pool.submit(_compile_in_child, share, bar) for share in shares]:
+                for f in [pool.submit(_compile_in_child, share, bar, lanes) for share in shares]:
                     f.result()
             for k in todo:  # load the cached machine code into this process
                 kernel(k)
@@ -443,12 +511,13 @@ def _shares(keys: list[KernelKey], jobs: int) -> list[list[KernelKey]]:
     return [s for s in shares if s]
 
 
-def _compile_in_child(keys: list[KernelKey], bar) -> None:
+def _compile_in_child(keys: list[KernelKey], bar, lanes: bool = False) -> None:
     code = ("import sys, json; from auvtrack.simulation.kernels import KernelKey, _child_compile; "
-            "_child_compile([KernelKey(**k) for k in json.loads(sys.argv[1])])")
+            "_child_compile([KernelKey(**k) for k in json.loads(sys.argv[1])], sys.argv[2] == '1')")
     arg = json.dumps([{"law": k.law, "plant": k.plant, "label": k.label} for k in keys])
     with tempfile.TemporaryFile("w+") as errf, subprocess.Popen(
-            [sys.executable, "-c", code, arg], stdout=subprocess.PIPE, stderr=errf, text=True) as proc:
+            [sys.executable, "-c", code, arg, "1" if lanes else "0"], stdout=subprocess.PIPE, stderr=errf,
+            text=True) as proc:
         for _ in proc.stdout:  # one line per kernel compiled
             bar.update(1)
         rc = proc.wait()
@@ -459,9 +528,9 @@ def _compile_in_child(keys: list[KernelKey], bar) -> None:
         raise RuntimeError(f"compiling {names} failed:\n{err.strip()}")
 
 
-def _child_compile(keys: list[KernelKey]) -> None:
+def _child_compile(keys: list[KernelKey], lanes: bool = False) -> None:
     for key in keys:
-        _compile_in_process(key)
+        _compile_in_process(key, lanes)
         print(key.name, flush=True)
 
 
