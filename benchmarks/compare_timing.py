@@ -1,13 +1,15 @@
 """Wall time of ``auvtrack compare`` on this machine: ``--quick`` and the default suite, after compilation.
 
-Usage: ``python benchmarks/compare_timing.py [--skip-default] [--workers N] [--out DIR]``.
+Usage: ``python benchmarks/compare_timing.py [--skip-default] [--workers N] [--out DIR] [--backend B ...]``.
 
 A first ``--quick`` comparison compiles every kernel the disk cache lacks, or loads it, and is timed as
 "cold" (its compile/load column says which happened); then, in the
 same process, ``--quick`` and the default suite run again with everything compiled.  The numbers
 written to ``benchmarks/compare_timing.{json,md}`` are the reports' own timing blocks
 (``results.json`` -> ``timing``: runs, compilation, analysis, load averages) plus the wall time of
-each ``compare`` call.  The machine may be shared: the load averages are part of the result.
+each ``compare`` call, for each batch back end asked for (``--backend``, default ``threads``; with
+``simd`` the cold row also compiles the lane kernels the disk cache lacks).  The machine may be
+shared: the load averages are part of the result.
 Never used as a timed unit test.
 """
 from __future__ import annotations
@@ -30,14 +32,15 @@ HERE = Path(__file__).resolve().parent
 TARGETS = {"quick (cold)": None, "quick": 120.0, "default": 900.0}  # s after compilation, issue 16
 
 
-def _one(label: str, out: Path, quick: bool, workers: int | None) -> dict:
+def _one(label: str, out: Path, quick: bool, workers: int | None, backend: str = "threads") -> dict:
     t0 = time.perf_counter()
-    res = compare(quick=quick, out=out, workers=workers, progress=True)
+    res = compare(quick=quick, out=out, workers=workers, progress=True, backend=backend)
     wall = time.perf_counter() - t0
     doc = json.loads((out / "results.json").read_text())
     timing = doc["timing"]
     after = timing["runs_seconds"] + timing["analysis_seconds"]
     target = TARGETS[label]
+    label = f"{label}, `{backend}`"
     runs = pd.read_parquet(out / "runs.parquet", columns=["task", "steps"])
     dt_ = float(doc["suite"]["file"]["base"].get("sim.dt", 0.002))
     full = runs["task"].map(lambda t: round(doc["suite"]["durations"][t] / dt_)).sum()
@@ -86,12 +89,16 @@ def main() -> None:
     ap.add_argument("--skip-default", action="store_true", help="only the --quick rows")
     ap.add_argument("--workers", type=int, default=None, help="local threads (default: every core)")
     ap.add_argument("--out", type=Path, default=None, help="folder of the comparisons (default: a new temp dir)")
+    ap.add_argument("--backend", action="append", default=None,
+                    help="batch back end of the comparisons (repeatable; default: threads)")
     args = ap.parse_args()
     root = args.out or Path(tempfile.mkdtemp(prefix="auvtrack-compare-timing-"))
-    rows = [_one("quick (cold)", root / "quick-cold", True, args.workers),
-            _one("quick", root / "quick", True, args.workers)]
-    if not args.skip_default:
-        rows.append(_one("default", root / "default", False, args.workers))
+    rows = []
+    for be in args.backend or ["threads"]:
+        rows += [_one("quick (cold)", root / be / "quick-cold", True, args.workers, be),
+                 _one("quick", root / be / "quick", True, args.workers, be)]
+        if not args.skip_default:
+            rows.append(_one("default", root / be / "default", False, args.workers, be))
     doc = {"measured": dt.datetime.now(dt.timezone.utc).isoformat(timespec="minutes"),
            "machine": f"{platform.machine()} / {_cpu()} / Python "
                       f"{platform.python_version()}", "cpu_count": os.cpu_count(), "version": __version__,
