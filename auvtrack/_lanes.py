@@ -1033,6 +1033,7 @@ def _first_lane(builder, mask, count: int):
 
 
 def _broadcast(builder, x, vty, count: int):
+    """The scalar ``x`` in every lane of a vector of type ``vty``."""
     one = builder.insert_element(ir.Constant(vty, ir.Undefined), x, _i32(0))
     return builder.shuffle_vector(one, one, ir.Constant(ir.VectorType(ir.IntType(32), count), [0] * count))
 
@@ -1053,11 +1054,10 @@ def _same_in_active_lanes(builder, mask, first, vals, args):
     return same
 
 
-def _same_in_every_lane(builder, vals, args):
-    """i1: every lane argument holds lane 0's bits in every lane (scalars are the same by nature)."""
-    count = next(t.count for t in args if isinstance(t, Lanes)) if any(isinstance(t, Lanes) for t in args) else 1
+def _same_in_every_lane(builder, vals, count: int):
+    """i1: each of the float64 lane vectors ``vals`` holds lane 0's bits in all ``count`` lanes."""
     full = ir.Constant(ir.VectorType(ir.IntType(1), count), [1] * count)
-    return _same_in_active_lanes(builder, full, _i32(0), vals, args)
+    return _same_in_active_lanes(builder, full, _i32(0), vals, [Lanes(types.float64, count)] * len(vals))
 
 
 def _masked_lanes(context, builder, impl, mask, lane_args, ssig, ret, count):
@@ -1087,7 +1087,8 @@ def _masked(fn, nargs: int):
         @intrinsic
         def call(typingctx, m, x, y):
             return _masked_typing(fn, typingctx, m, (x, y))
-    call.__doc__ = f"``{getattr(fn, '__name__', fn)}`` of the arguments in the lanes of the mask only (0 elsewhere)."
+    call.__doc__ = (f"``{getattr(fn, '__name__', fn)}`` of the arguments in the lanes of the mask only (once when "
+                    "their arguments have the same bits); the other lanes' values are unspecified.")
     return call
 
 

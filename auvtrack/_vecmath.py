@@ -143,8 +143,7 @@ def _lane_call(name: str, width: int):
         fn.attributes.add("readnone")
         entries = [[(builder.extract_value(a, k), aty.types[k]) for a, aty in zip(args, signature.args)]
                    for k in range(width)]
-        lane_vals = [v for e in entries for v, t in e if isinstance(t, Lanes)]
-        same = _same_in_every_lane(builder, lane_vals, [lt] * len(lane_vals))
+        same = _same_in_every_lane(builder, [v for e in entries for v, t in e if isinstance(t, Lanes)], L)
         with builder.if_else(same) as (uniform, varied):
             with uniform:
                 outs_u = _uniform_entries(context, builder, name, entries, len(args), L)
@@ -189,7 +188,7 @@ def _uniform_entries(context, builder, name: str, entries, nargs: int, L: int):
     """The single run's call of the 4-lane ``name`` on lane 0 of each entry, each result broadcast to L lanes."""
     from llvmlite import ir
 
-    from ._lanes import Lanes
+    from ._lanes import Lanes, _broadcast
 
     v4 = ir.VectorType(ir.DoubleType(), 4)
     fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(v4, [v4] * nargs), name)
@@ -207,10 +206,9 @@ def _uniform_entries(context, builder, name: str, entries, nargs: int, L: int):
                 vec = builder.insert_element(vec, firsts[4 * part + k][j], ir.Constant(ir.IntType(32), k))
             vecs.append(vec)
         r = builder.call(fn, vecs)
-        for k in range(4):
-            x = builder.extract_element(r, ir.Constant(ir.IntType(32), k))
-            one = builder.insert_element(ir.Constant(ir.VectorType(ir.DoubleType(), L), ir.Undefined), x, zero)
-            outs.append(builder.shuffle_vector(one, one, ir.Constant(ir.VectorType(ir.IntType(32), L), [0] * L)))
+        vL = ir.VectorType(ir.DoubleType(), L)
+        outs += [_broadcast(builder, builder.extract_element(r, ir.Constant(ir.IntType(32), k)), vL, L)
+                 for k in range(4)]
     return outs
 
 

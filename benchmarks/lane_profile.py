@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -33,11 +34,28 @@ def _object_code(nbc: Path) -> bytes:
     return data[i:i + shoff + shentsize * shnum]
 
 
+def _demangle(symbol: str) -> str:
+    """``a.b.name`` from a Numba symbol ``_ZN<len>a<len>b<len>nameB...`` (the part before its type signature)."""
+    if not symbol.startswith("_ZN"):
+        return symbol
+    parts, i = [], 3
+    while i < len(symbol) and symbol[i].isdigit():
+        j = i
+        while symbol[j].isdigit():
+            j += 1
+        parts.append(symbol[j:j + int(symbol[i:j])])
+        i = j + int(symbol[i:j])
+    return ".".join(parts) or symbol
+
+
 def _perf_map(module, library) -> None:
-    """Write /tmp/perf-<pid>.map for the functions of the lane kernel's object code."""
-    nbc = sorted(Path(module.__file__).parent.glob(f"__pycache__/{Path(module.__file__).stem}.run_lanes-*.nbc"))
-    if not nbc:  # Numba keeps the cache next to the module unless it cannot write there
-        nbc = sorted(Path(module.__file__).parent.parent.glob(f"kernels_*/{Path(module.__file__).stem}.run_lanes-*.nbc"))
+    """Write /tmp/perf-<pid>.map for the functions of the lane kernel's object code.
+
+    With ``numba.config.CACHE_DIR`` set (``auvtrack._jit``), Numba keeps a module's cache in
+    ``<CACHE_DIR>/<folder>_<hash>/``: for the generated lanes module, next to ``kernels/``.
+    """
+    path = Path(module.__file__)
+    nbc = sorted(path.parent.parent.glob(f"kernels_*/{path.stem}.run_lanes-*.nbc"))
     with tempfile.NamedTemporaryFile(suffix=".o") as f:
         f.write(_object_code(nbc[-1]))
         f.flush()
@@ -48,8 +66,7 @@ def _perf_map(module, library) -> None:
         if len(parts) == 4 and parts[2] in "TtWw":
             addr = library._codegen._engine.get_function_address(parts[3])
             if addr:
-                short = parts[3].split("__lanes")[0].rsplit("20", 1)[-1][-40:] + "__lanes" if "__lanes" in parts[3] else parts[3][:50]
-                lines.append(f"{addr:x} {int(parts[1], 16):x} {short}\n")
+                lines.append(f"{addr:x} {int(parts[1], 16):x} {_demangle(parts[3])}\n")
     Path(f"/tmp/perf-{os.getpid()}.map").write_text("".join(lines))
 
 
@@ -63,6 +80,8 @@ def child(kind: str, seconds: float) -> None:
     preps = [prepare(load_scenario(paper_scenario_path(), {"sim.duration": 10.0, "seed": i, "uncertainty.D": 0.005 * i,
                                                            "controller.kind": kind})) for i in range(16)]
     run_batch(preps, backend="simd", workers=1)
+    if seconds <= 0:  # the compile-only run
+        return
     module = kernels.lanes_module(preps[0].key)
     _perf_map(module, next(iter(module.run_lanes.overloads.values())).library)
     t0 = time.time()
@@ -89,6 +108,9 @@ def main() -> None:
                         *cmd, "--seconds", str(args.seconds)], check=True)
         report = subprocess.run(["perf", "report", "-i", str(data), "--stdio", "--sort", "dso,sym"],
                                 capture_output=True, text=True, check=True).stdout
+        pid = re.search(r"\[JIT\] tid (\d+)", report)
+        if pid:  # the child's map, read by the report: no longer needed
+            Path(f"/tmp/perf-{pid.group(1)}.map").unlink(missing_ok=True)
     rows = [r for r in report.splitlines() if r.strip() and not r.startswith("#")]
     print(f"perf samples by function, {args.controller}, {args.seconds:g} s of 16-run SIMD batches:")
     print("\n".join(rows[:args.top]))

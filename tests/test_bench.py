@@ -67,6 +67,31 @@ def test_batch_efficiency_is_throughput_relative_to_single_runs():
     assert batch_efficiency({**row, "runs_per_s": 500.0}, us_per_step=1.0) == pytest.approx(2.5)
 
 
+def test_simd_over_serial_compares_the_same_runs_and_cpu_efficiency_divides_by_the_single_run():
+    """8 ms per run serial and 3.2 ms in lanes: 2.5; a single run of 10^4 steps at 0.9 CPU us per step
+    (9 ms) over 3.6 ms per batch run: CPU efficiency 2.5."""
+    from auvtrack.runner.sweep_bench import batch_cpu_efficiency, simd_over_serial
+
+    batch = {("fxtntsmc", "serial"): {"cpu_ms_per_run": 8.0}, ("fxtntsmc", "simd"): {"cpu_ms_per_run": 3.2}}
+    assert simd_over_serial(batch, "fxtntsmc") == pytest.approx(2.5)
+    assert batch_cpu_efficiency({"run_seconds": 10.0, "cpu_ms_per_run": 3.6}, cpu_us_per_step=0.9) == pytest.approx(2.5)
+
+
+def test_warmup_simd_flag_reaches_the_lane_kernel_compile(monkeypatch, capsys):
+    """``auvtrack warmup --simd`` asks for the SIMD batch kernels too; without the flag it does not."""
+    import json
+
+    from auvtrack.cli import main
+    from auvtrack.simulation import kernels
+
+    asked = []
+    monkeypatch.setattr(kernels, "warmup", lambda keys, progress=False, lanes=False: asked.append(lanes) or [])
+    for extra in (["--simd"], []):
+        assert main(["warmup", "--controller", "pid", "--plant", "5dof", *extra]) == 0
+        assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["kernels"] == ["pid on 5dof"]
+    assert asked == [True, False]
+
+
 def test_cold_start_compiles_only_the_kernel_it_needs():
     """The cold run is timed in a new process with an empty cache; it compiles the one kernel of the run."""
     from auvtrack.runner.sweep_bench import bench_cold_start

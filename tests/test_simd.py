@@ -358,11 +358,11 @@ def test_lane_kernel_lives_next_to_its_kernel_in_the_keyed_cache():
 
 def test_warmup_compiles_the_lane_kernel_a_simd_batch_then_uses():
     """``compile_lanes`` compiles run_lanes for exactly the types the SIMD back end passes: a batch
-    afterwards compiles nothing; ``warmup(..., lanes=True)`` marks it on disk, ``lanes_compiled``."""
+    afterwards compiles nothing; it is marked on disk (``is_compiled(key, lanes=True)``)."""
     preps = [prepare(load_scenario(PAPER, {"controller.kind": "pid", "seed": i, "sim.duration": 0.05}))
              for i in range(L)]
     key = preps[0].key
-    assert kernels.compile_lanes(key) and kernels.lanes_compiled(key)
+    assert kernels.compile_lanes(key) and kernels.is_compiled(key, lanes=True)
     run_lanes = kernels.lanes_module(key).run_lanes
     before = list(run_lanes.signatures)
     assert len(before) == 1

@@ -258,23 +258,27 @@ _LOADED: dict[str, Callable] = {}
 _LOCK = threading.RLock()
 
 
-def _marker(key: KernelKey) -> Path:
-    return _folder() / f"{key.name}.compiled.json"
+def _marker(key: KernelKey, lanes: bool = False) -> Path:
+    return _folder() / f"{key.name}.{'lanes' if lanes else 'compiled'}.json"
 
 
-def is_compiled(key: KernelKey) -> bool:
+def is_compiled(key: KernelKey, lanes: bool = False) -> bool:
     """True when the kernel of ``key`` is compiled in this process or cached on disk.
 
     Parameters
     ----------
     key : KernelKey
         The pair.
+    lanes : bool, optional
+        Ask about its SIMD batch kernel (:func:`compile_lanes`) instead.
 
     Returns
     -------
     bool
-        Whether running it needs no compilation.
+        Whether running it (or its first SIMD batch) needs no compilation.
     """
+    if lanes:
+        return _marker(key, lanes=True).is_file()
     loaded = _LOADED.get(key.name)
     if loaded is not None and loaded.signatures:
         return True
@@ -339,8 +343,13 @@ def mark_compiled(key: KernelKey, seconds: float) -> None:
     _write_if_changed(_marker(key), json.dumps({"kernel": key.name, "seconds": round(seconds, 2)}))
 
 
-def compile_estimate() -> float:
+def compile_estimate(lanes: bool = False) -> float:
     """Seconds one kernel took to compile here the last times (median of the markers), or a default.
+
+    Parameters
+    ----------
+    lanes : bool, optional
+        The estimate for a SIMD batch kernel (:func:`compile_lanes`) instead.
 
     Returns
     -------
@@ -349,7 +358,7 @@ def compile_estimate() -> float:
     """
     times = []
     root = _jit.cache_dir().parent
-    for marker in root.glob("*/kernels/*.compiled.json"):
+    for marker in root.glob(f"*/kernels/*.{'lanes' if lanes else 'compiled'}.json"):
         try:
             times.append(float(json.loads(marker.read_text())["seconds"]))
         except (OSError, ValueError, KeyError):
@@ -380,26 +389,6 @@ def example_lane_arguments() -> tuple:
             np.zeros((1, L), np.int64), np.zeros((1, L)), 0, 0)
 
 
-def _lanes_marker(key: KernelKey) -> Path:
-    return _folder() / f"{key.name}.lanes.json"
-
-
-def lanes_compiled(key: KernelKey) -> bool:
-    """True when the SIMD batch kernel of ``key`` has been compiled into the on-disk cache.
-
-    Parameters
-    ----------
-    key : KernelKey
-        The pair.
-
-    Returns
-    -------
-    bool
-        Whether its first SIMD batch needs no compilation.
-    """
-    return _lanes_marker(key).is_file()
-
-
 def compile_lanes(key: KernelKey) -> bool:
     """Compile (or load) the SIMD batch kernel of ``key`` for the types the batch runner passes.
 
@@ -422,7 +411,8 @@ def compile_lanes(key: KernelKey) -> bool:
         lanes_module(key).run_lanes(*example_lane_arguments())
     except (NotLaneable, NumbaError):
         return False
-    _write_if_changed(_lanes_marker(key), json.dumps({"kernel": key.name, "seconds": round(time.perf_counter() - t0, 2)}))
+    _write_if_changed(_marker(key, lanes=True), json.dumps({"kernel": key.name,
+                                                           "seconds": round(time.perf_counter() - t0, 2)}))
     return True
 
 
@@ -431,7 +421,7 @@ def _compile_in_process(key: KernelKey, lanes: bool = False) -> float:
     if not is_compiled(key):
         _compile_run(kernel(key))
         mark_compiled(key, time.perf_counter() - t0)
-    if lanes and not lanes_compiled(key):
+    if lanes and not is_compiled(key, lanes=True):
         compile_lanes(key)
     return time.perf_counter() - t0
 
@@ -465,19 +455,21 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
     list of KernelKey
         The keys that were compiled now.
     """
-    todo = []
+    todo, per_key = [], []
+    per, per_lanes = compile_estimate(), compile_estimate(lanes=True) if lanes else 0.0
     for k in dict.fromkeys(keys):  # each key once, in order
-        if not is_compiled(k) or (lanes and not lanes_compiled(k)):
+        cost = (0.0 if is_compiled(k) else per) + (per_lanes if lanes and not is_compiled(k, lanes=True) else 0.0)
+        if cost:
             todo.append(k)
+            per_key.append(cost)
     if not todo:
         return []
     jobs = jobs or _cores()
-    per = compile_estimate()
     waves = -(-len(todo) // max(1, jobs))
     say = notice or (lambda text: print(text, file=sys.stderr, flush=True))
     names = ", ".join(k.label or k.name for k in todo)
     what = "kernels and their SIMD batch forms" if lanes else "kernels"
-    say(f"compiling {what} (first run only, about {per * waves * (3 if lanes else 1):.0f} s): {names}")
+    say(f"compiling {what} (first run only, about {max(per_key) * waves:.0f} s): {names}")
     bar = _bar(len(todo), progress)
     try:
         if len(todo) == 1 or jobs == 1:
