@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from .._atomic import atomic_file, atomic_write
+from .dask_wait import ClusterLost
 
 __all__ = ["RunSpec", "plan_runs", "run_chunk", "execute", "ExecOutcome", "CompareError", "chunk_path",
            "MANIFEST", "RUNS_FILE", "FIXED_COLUMNS"]
@@ -379,8 +380,13 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
                         break
                 seconds = time.perf_counter() - t0
             else:
-                written, seconds = _on_dask(out, chunks, todo, client, scheduler, bar, max_chunks, on_chunk,
-                                            backend)
+                try:
+                    written, seconds = _on_dask(out, chunks, todo, client, scheduler, bar, max_chunks, on_chunk,
+                                                backend)
+                except ClusterLost as exc:
+                    kept = sum(1 for c in range(len(chunks)) if chunk_path(out, c).exists())
+                    raise CompareError(f"{exc}; {kept} of {len(chunks)} chunks are kept in {out}: "
+                                       "finish with --resume once the cluster has workers") from None
         finally:
             bar.close()
     complete = all(chunk_path(out, c).exists() for c in range(len(chunks)))
@@ -391,8 +397,9 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
 
 def _on_dask(out: Path, chunks, todo, client, scheduler, bar, max_chunks, on_chunk,
              backend: str | None = None) -> tuple[int, float]:
-    from dask.distributed import Client, as_completed
+    from dask.distributed import Client
 
+    from .dask_wait import completed
     from .sweep_worker import WarmupPlugin
 
     own = client is None
@@ -406,7 +413,7 @@ def _on_dask(out: Path, chunks, todo, client, scheduler, bar, max_chunks, on_chu
         futures = [client.submit(run_chunk, chunks[c], backend=backend, key=f"auvtrack-compare-{token}-{c}", retries=1) for c in todo]
         chunk_of = {f.key: c for f, c in zip(futures, todo)}
         try:
-            for fut in as_completed(futures):
+            for fut in completed(futures, client, what="running the comparison's chunks"):
                 table = fut.result()
                 path = chunk_path(out, chunk_of[fut.key])
                 if not path.exists():

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .._atomic import atomic_file, atomic_write
+from .dask_wait import ClusterLost
 from .sweep_schema import StudyError, StudySpec, load_study
 
 MANIFEST = "study.json"
@@ -222,6 +223,10 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
         try:
             written, seconds = _compute(spec, out, todo, client, max_chunks, progress, on_chunk,
                                         n_done=sum(len(spec.chunk_range(c)) for c in done))
+        except ClusterLost as exc:
+            kept = sum(1 for c in range(spec.n_chunks) if chunk_path(out, c).exists())
+            raise StudyError(f"{exc}; {kept} of {spec.n_chunks} chunks are kept in {out}: "
+                             "finish with --resume once the cluster has workers") from None
         finally:
             if own:
                 client.close()
@@ -240,9 +245,9 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
 
 def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: int | None, progress: bool,
              on_chunk, n_done: int) -> tuple[int, float]:
-    from dask.distributed import as_completed
     from tqdm.auto import tqdm
 
+    from .dask_wait import completed
     from .sweep_worker import WarmupPlugin, run_chunk
 
     client.register_plugin(WarmupPlugin(), name=WarmupPlugin.name)
@@ -254,7 +259,7 @@ def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: in
     bar = tqdm(total=spec.n_samples, initial=n_done, unit="sample", desc=spec.study.name, disable=not progress,
                smoothing=0.1)
     try:
-        for fut in as_completed(futures):
+        for fut in completed(futures, client, what="running the sweep's chunks"):
             c = chunk_of[fut.key]
             table = _chunk_table(spec, c, fut, client, token)
             path = chunk_path(out, c)
@@ -284,10 +289,11 @@ def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str, attempts:
     """
     from distributed import KilledWorker
 
+    from .dask_wait import result
     from .sweep_worker import lost_rows, run_samples
 
     try:
-        return fut.result()
+        return result(fut, client, what=f"running chunk {chunk}")
     except KilledWorker:
         pass
     import pyarrow as pa
@@ -297,7 +303,7 @@ def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str, attempts:
         for attempt in range(attempts):
             single = client.submit(run_samples, spec, [i], key=f"auvtrack-sample-{token}-{i}-{attempt}", retries=0)
             try:
-                tables.append(single.result())
+                tables.append(result(single, client, what=f"running sample {i} alone"))
                 break
             except KilledWorker as exc:
                 reason = " ".join(str(exc).split())[:200]
