@@ -12,7 +12,7 @@ __all__ = ["__version__", "simulate", "load_scenario", "Result"]
 
 def __getattr__(name):  # lazy: importing auvtrack must not compile anything
     if name == "simulate":
-        from .simulation.api import simulate
+        from .simulation.pipeline import simulate
 
         return simulate
     if name == "load_scenario":

@@ -28,8 +28,8 @@ from pathlib import Path
 WORKER = r"""
 import json, sys, time
 from auvtrack.scenario import load_scenario
-from auvtrack.simulation.api import prepare
-from auvtrack.runner.batch import run_metrics
+from auvtrack.simulation.pipeline import prepare
+from auvtrack.batch.runner import run_metrics
 from auvtrack.scenario import paper_scenario_path
 import auvtrack
 print(json.dumps(auvtrack.__file__), flush=True)

@@ -26,7 +26,7 @@ from pathlib import Path
 import pandas as pd
 
 from auvtrack import __version__
-from auvtrack.studies.benchmark import compare
+from auvtrack.benchmark.compare import compare
 
 HERE = Path(__file__).resolve().parent
 TARGETS = {"quick (cold)": None, "quick": 120.0, "default": 900.0}  # s after compilation, issue 16

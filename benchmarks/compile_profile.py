@@ -77,17 +77,17 @@ class L(ev.Listener):
 for kind in ("numba:compile", "numba:run_pass", "numba:llvm_lock"):
     ev.register(kind, L())
 t0 = time.perf_counter()
-from auvtrack.simulation import kernels
+from auvtrack.engine import kernels
 from auvtrack.control import CONTROLLERS
 from auvtrack.plant import PLANTS
 t_import = time.perf_counter() - t0
 c, p, lanes = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
 key = kernels.KernelKey(CONTROLLERS[c].module, PLANTS[p].module, f"{c} on {p}")
 if lanes:  # the SIMD batch kernel (its scalar kernel first, not counted)
-    from auvtrack.runner.batch import run_batch
+    from auvtrack.batch.runner import run_batch
     from auvtrack.scenario import load_scenario, paper_scenario_path
-    from auvtrack.simulation.api import prepare
-    from auvtrack.simulation.engine import LANES
+    from auvtrack.simulation.pipeline import prepare
+    from auvtrack.engine.loop import LANES
     preps = [prepare(load_scenario(paper_scenario_path(), {"controller.kind": c, "sim.duration": 0.01, "seed": i}))
              for i in range(LANES)]  # one full block: fewer runs would go to the single-run kernel
     run_batch(preps, backend="serial")

@@ -51,7 +51,7 @@ def _demangle(symbol: str) -> str:
 def _perf_map(module, library) -> None:
     """Write /tmp/perf-<pid>.map for the functions of the lane kernel's object code.
 
-    With ``numba.config.CACHE_DIR`` set (``auvtrack._jit``), Numba keeps a module's cache in
+    With ``numba.config.CACHE_DIR`` set (``auvtrack.engine.jit``), Numba keeps a module's cache in
     ``<CACHE_DIR>/<folder>_<hash>/``: for the generated lanes module, next to ``kernels/``.
     """
     path = Path(module.__file__)
@@ -72,10 +72,10 @@ def _perf_map(module, library) -> None:
 
 def child(kind: str, seconds: float) -> None:
     """The profiled process (see the module docstring)."""
-    from auvtrack.runner.batch import run_batch
+    from auvtrack.batch.runner import run_batch
     from auvtrack.scenario import load_scenario, paper_scenario_path
-    from auvtrack.simulation import kernels
-    from auvtrack.simulation.api import prepare
+    from auvtrack.engine import kernels
+    from auvtrack.simulation.pipeline import prepare
 
     preps = [prepare(load_scenario(paper_scenario_path(), {"sim.duration": 10.0, "seed": i, "uncertainty.D": 0.005 * i,
                                                            "controller.kind": kind})) for i in range(16)]

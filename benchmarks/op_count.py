@@ -43,8 +43,8 @@ CHILD = r"""
 import json, re, sys
 from collections import Counter
 from auvtrack.scenario import load_scenario, paper_scenario_path
-from auvtrack.simulation.api import prepare, run_prepared
-from auvtrack.simulation import kernels
+from auvtrack.simulation.pipeline import prepare, run_prepared
+from auvtrack.engine import kernels
 prep = prepare(load_scenario(paper_scenario_path(), {"controller.kind": sys.argv[1], "sim.duration": 0.01}))
 run_prepared(prep)
 run = kernels.kernel(prep.key)

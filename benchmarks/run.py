@@ -9,7 +9,7 @@ import argparse
 import json
 from pathlib import Path
 
-from auvtrack.runner.bench import bench_all
+from auvtrack.perf.bench import bench_all
 
 
 def main() -> None:

@@ -22,9 +22,9 @@ def ratio(overrides: dict, *, runs: int = 16, repeat: int = 7, duration: float =
     """Median serial / SIMD CPU-time ratio of ``runs`` runs of the Section 4 scenario with ``overrides``."""
     import numpy as np
 
-    from auvtrack.runner.batch import run_batch
+    from auvtrack.batch.runner import run_batch
     from auvtrack.scenario import load_scenario, paper_scenario_path
-    from auvtrack.simulation.api import prepare
+    from auvtrack.simulation.pipeline import prepare
     from auvtrack.simulation.metrics import METRIC_NAMES
 
     preps = [prepare(load_scenario(paper_scenario_path(), {"sim.duration": duration, "seed": i,
@@ -58,7 +58,7 @@ def main() -> None:
     ap.add_argument("--breakdown", action="store_true")
     args = ap.parse_args()
     if args.breakdown:
-        from auvtrack.runner.sweep_bench import BREAKDOWN
+        from auvtrack.perf.sweep_bench import BREAKDOWN
 
         cases = [(label, ov) for label, ov in BREAKDOWN]
     else:

@@ -17,6 +17,6 @@ def pytest_collection_finish(session):
     A run of a few tests skips this; ``AUVTRACK_TEST_WARMUP=0`` turns it off."""
     if len(session.items) < 200 or os.environ.get("AUVTRACK_TEST_WARMUP", "1") == "0":
         return
-    from auvtrack.runner.bench import warmup
+    from auvtrack.simulation.compiling import warmup
 
     warmup(progress=False)

@@ -1,12 +1,12 @@
-"""Compiled functions exercising every construct of the lane rewrite (auvtrack.simulation.lanes), for tests.
+"""Compiled functions exercising every construct of the lane rewrite (auvtrack.engine.lanes), for tests.
 
 Each is an ordinary compiled function of scalars; tests/test_simd.py checks that its lane form gives,
 lane by lane, exactly the scalar function's results.
 """
 import math
 
-from auvtrack._jit import njit, njit_noalloc
-from auvtrack._vecmath import atanh4, exp8, pow4, sincos4
+from auvtrack.engine.jit import njit, njit_noalloc
+from auvtrack.engine.vecmath import atanh4, exp8, pow4, sincos4
 
 
 @njit

@@ -12,15 +12,15 @@ import sys
 
 import numpy as np
 
-from auvtrack._jit import njit
+from auvtrack.engine.jit import njit
 from auvtrack.control import fxtntsmc
 from auvtrack.control.contract import WORK_SIZE
-from auvtrack.control.envelopes import baseline
-from auvtrack.plant.kinematics import attitude, virtual_point
-from auvtrack.plant.params import ELL
+from auvtrack.control.fxtntsmc.envelopes import baseline
+from auvtrack.vehicle.kinematics import attitude, virtual_point
+from auvtrack.vehicle.params import ELL
 from auvtrack.reference import eval_reference
 from auvtrack.scenario import load_scenario
-from auvtrack.simulation.api import prepare
+from auvtrack.simulation.pipeline import prepare
 
 N_POINTS = 3000
 NXP = 10  # Xs rows: the 5-DOF plant state, then the controller's state xc

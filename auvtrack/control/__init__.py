@@ -4,7 +4,7 @@ Registering a built-in controller is one line: its module in :data:`BUILTIN`.  `
 registered after them: it is the loader of controllers from outside the package (kind ``"plugin"``).
 """
 from . import backstepping, ftsmc, fxtntsmc, open_loop, open_loop_actuators, pid, plugin, ppc, sta
-from .params import FTSMCParams, FXTNTSMCParams, OpenLoopParams
+from .gain_presets import FTSMCParams, FXTNTSMCParams, OpenLoopParams
 from .registry import CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, get, register
 
 BUILTIN = (

@@ -7,7 +7,7 @@ Every controller's compiled law has the signature
 =======  ==============================================================================
 t        time (s)
 eta, nu  measured state, 5-tuples (x, y, z, theta, psi) (m, rad) and (u, v, w, q, r) (m/s,
-         rad/s) (see :mod:`auvtrack.plant.kinematics`); with a 6-DOF plant the projection of
+         rad/s) (see :mod:`auvtrack.vehicle.kinematics`); with a 6-DOF plant the projection of
          its state (roll neither measured nor controlled)
 att      attitude(eta[3], eta[4]) = (cos theta, sin theta, cos psi, sin psi) of the measured
          state, computed by the engine (in continuous mode the 5-DOF plant shares it)

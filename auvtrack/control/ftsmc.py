@@ -20,7 +20,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .._jit import njit, njit_noalloc
+from ..engine.jit import njit, njit_noalloc
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
 

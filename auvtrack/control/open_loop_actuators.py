@@ -22,7 +22,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .._jit import njit
+from ..engine.jit import njit
 from .registry import CompiledController, ControllerParams
 
 NAME = "open_loop_actuators"

@@ -27,9 +27,9 @@ import numpy as np
 from pydantic import Field
 from typing import Literal
 
-from .._jit import njit, njit_noalloc
-from ..plant.kinematics import j3
-from ..plant.params import ELL, M0
+from ..engine.jit import njit, njit_noalloc
+from ..vehicle.kinematics import j3
+from ..vehicle.params import ELL, M0
 from .gain_checks import require
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, mat_vec

@@ -12,7 +12,7 @@ Checks, each a one-line error naming the file and the missing piece: when the sc
 contract's names, and ``params`` validates against its ``Params``; at set-up, ``setup`` returns a
 ``CompiledController`` whose shapes are right and ``control`` compiles and returns an int status
 at the initial state.  The law is then compiled into its own kernel and cached like a built-in
-(:mod:`auvtrack.simulation.kernels`).  This module also re-exports what a plug-in needs, so that a
+(:mod:`auvtrack.engine.kernels`).  This module also re-exports what a plug-in needs, so that a
 plug-in file imports from one place.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, Field, ValidationError, ValidationInfo, field_validator
 
-from .._jit import njit, njit_noalloc
+from ..engine.jit import njit, njit_noalloc
 from .contract import CONTROLLER_STATUS, WORK_SIZE
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state, error_state_forces, input_for_accel, input_for_accel_forces, sig, sign
@@ -113,7 +113,7 @@ def load(law: str):
     ValueError
         ``<file>: ...`` when it cannot be imported or lacks a name of the contract.
     """
-    from ..simulation.kernels import law_module
+    from ..engine.kernels import law_module
 
     if law.endswith(".py") and not Path(law).is_file():
         raise ValueError(f"no such file {law}")
@@ -193,7 +193,7 @@ def _check_compiled(cc: Any, mod, law: str) -> CompiledController:
 
 def _probe(mod, law: str, cc: CompiledController, scenario, ctx) -> None:
     """Call the compiled law once at the initial state: it must compile and return an int status."""
-    from ..plant.kinematics import attitude
+    from ..vehicle.kinematics import attitude
 
     eta, nu = tuple(float(x) for x in scenario.initial.eta), tuple(float(x) for x in scenario.initial.nu)
     tau, dxc, aux = np.zeros(3), np.zeros(cc.xc0.size), np.zeros(len(cc.aux_names))

@@ -37,7 +37,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field
 
-from .._jit import njit, njit_noalloc
+from ..engine.jit import njit, njit_noalloc
 from .gain_checks import fmt, require
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces

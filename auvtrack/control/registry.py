@@ -11,7 +11,7 @@ A controller is one module (the contract is in :mod:`auvtrack.control.contract`)
 
 Registering a built-in controller is one line in :mod:`auvtrack.control` (its module in the
 ``BUILTIN`` tuple).  The engine's kernel for a (controller, plant) pair is generated and compiled
-on demand (:mod:`auvtrack.simulation.kernels`), so no code elsewhere names a controller.
+on demand (:mod:`auvtrack.engine.kernels`), so no code elsewhere names a controller.
 """
 from __future__ import annotations
 

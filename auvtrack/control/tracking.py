@@ -10,14 +10,14 @@ With eta1 the virtual point (eq. 2) and eta_d the reference,
 J4_dot needs the unactuated sway/heave accelerations; controllers take them from the nominal
 model (ERRATA 4); everything the nominal model misses is the lumped disturbance chi.
 :func:`input_for_accel` inverts the map: the nominal input that yields a desired e_ddot.
-All functions are compiled and work on tuples (see :mod:`auvtrack.plant.kinematics`).
+All functions are compiled and work on tuples (see :mod:`auvtrack.vehicle.kinematics`).
 """
 from __future__ import annotations
 
-from .._jit import njit, njit_noalloc
-from ..plant.dynamics import generalized_forces
-from ..plant.kinematics import j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
-from ..plant.params import ELL, M0
+from ..engine.jit import njit, njit_noalloc
+from ..vehicle.dynamics import generalized_forces
+from ..vehicle.kinematics import j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
+from ..vehicle.params import ELL, M0
 
 
 @njit

@@ -37,9 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import njit_noalloc
-from ..plant.kinematics import attitude, body_from_ned
-from ..plant.params import D0
+from ..engine.jit import njit_noalloc
+from ..vehicle.kinematics import attitude, body_from_ned
+from ..vehicle.params import D0
 from . import _validate as val
 from .layout import C_DT, C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, ROW_SIZE
 
@@ -154,7 +154,7 @@ def current_velocity(rows, r, current, t):
 def add_current_force(vx, vy, vz, eta, vp, out):
     """Add omega[0:3] = diag(d11, d22, d33) J1(theta, psi)^T V_c (N) to ``out`` (5,).
 
-    V_c = (vx, vy, vz) is the NED current (m/s); J1^T is :func:`~auvtrack.plant.kinematics.body_from_ned`.
+    V_c = (vx, vy, vz) is the NED current (m/s); J1^T is :func:`~auvtrack.vehicle.kinematics.body_from_ned`.
     """
     uc, vc, wc = body_from_ned(attitude(eta[3], eta[4]), (vx, vy, vz))
     out[0] += vp[D0] * uc

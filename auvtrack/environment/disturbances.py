@@ -1,7 +1,7 @@
 """Deterministic external disturbances omega(t) acting on the 5-DOF AUV.
 
 omega = [F_u, F_v, F_w, M_q, M_r] enters the kinetics as ``M nu_dot + ... = tau + omega``
-(:mod:`auvtrack.plant.dynamics`): forces in N along the body surge, sway and heave axes and
+(:mod:`auvtrack.vehicle.dynamics`): forces in N along the body surge, sway and heave axes and
 moments in N m about the body pitch and yaw axes.
 
 * :class:`PaperDisturbance` -- the sinusoidal disturbance of the paper's simulation study
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import njit_noalloc
-from .._vecmath import sincos4
+from ..engine.jit import njit_noalloc
+from ..engine.vecmath import sincos4
 from . import _validate as val
 from .layout import KIND_PAPER, KIND_PULSE, P_AMP, P_PHASE, ROW_SIZE, U_END, U_FORCE, U_START
 

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._jit import njit, njit_noalloc
+from ..engine.jit import njit, njit_noalloc
 from .._seeding import rng
-from ..plant.params import VP_SIZE
+from ..vehicle.params import VP_SIZE
 from .current import GaussMarkovCurrent, add_current_force, current_velocity
 from .disturbances import PaperDisturbance, Pulse, add_paper, add_pulse
 from .layout import C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, KIND_PAPER, KIND_PULSE, ROW_SIZE

@@ -5,7 +5,7 @@ nu = (u, v, w, q, r) (m/s, rad/s; body).  Actuator command ``cmd`` (``N_CMD = 3`
 tau (N, N m, N m) after the magnitude saturation and, in sampled-data mode, the slew-rate limit
 of :mod:`auvtrack.plant.actuators`.  No extra logged channels.
 
-Packed parameters ``pp`` = [vp_true (13, layout of :mod:`auvtrack.plant.params`), tau_max (3),
+Packed parameters ``pp`` = [vp_true (13, layout of :mod:`auvtrack.vehicle.params`), tau_max (3),
 rate_max (3)]: the true vehicle (the scenario's ``[uncertainty]`` applied to its preset) and the
 actuator limits.  Disturbance: omega of :func:`auvtrack.environment.eval_disturbance`, with the
 current as the damping force on the relative velocity.
@@ -22,13 +22,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import njit_noalloc
+from ..engine.jit import njit_noalloc
 from ..environment import eval_disturbance
 from .actuators import ACT_SIZE, pack_actuator, rate_limit, saturate
 from .contract import CAUSE_PITCH, SF_THETA_LIM
-from .dynamics import nu_dot
-from .kinematics import eta_dot
-from .params import VP_SIZE
+from ..vehicle.dynamics import nu_dot
+from ..vehicle.kinematics import eta_dot
+from ..vehicle.params import VP_SIZE
 from .registry import CompiledPlant
 
 NAME = "5dof"
@@ -93,7 +93,7 @@ def log_extra(x, cmd, pp, log, row, col):
 
 def setup(scenario) -> CompiledPlant:
     """Pack the true 5-DOF vehicle and actuator limits of ``scenario`` and its initial state."""
-    from .presets import vehicle_arrays
+    from ..vehicle.presets import vehicle_arrays
 
     _, vp_true, record = vehicle_arrays(scenario)
     act = scenario.actuator

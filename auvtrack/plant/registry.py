@@ -5,7 +5,7 @@ A plant is one module that defines the compiled functions of the plant contract
 ``allocate``, ``rhs``, ``applied``, ``attitude_cause`` and ``log_extra``, and a Python ``setup``
 that packs its parameters and initial state.  Registering a plant is one line in
 :mod:`auvtrack.plant` (``register(PlantSpec.from_module(module))``); the engine's kernel for a
-(controller, plant) pair is generated on demand (:mod:`auvtrack.simulation.kernels`).
+(controller, plant) pair is generated on demand (:mod:`auvtrack.engine.kernels`).
 """
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ logged rows, control samples, noise and current table rows and an estimate of th
 the run's arrays.  Each number that becomes an integer is range-checked against the scenario's
 ``[limits]`` *before* it is converted, so an absurd grid (``dt = 1e-12``, ``duration = 1e300``)
 is one line naming the field and the limit, never an endless run, a NumPy allocation traceback
-or an ``OverflowError``.  :func:`auvtrack.simulation.api.prepare` calls it, so ``auvtrack check``,
+or an ``OverflowError``.  :func:`auvtrack.simulation.pipeline.prepare` calls it, so ``auvtrack check``,
 ``auvtrack run``, batches and sweeps all refuse the same scenarios with the same message.
 
 The limits and how to raise them are documented in ``docs/scenarios.md`` (``[limits]``).

@@ -15,11 +15,11 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_v
                       model_validator)
 
 from ..control import CONTROLLERS
-from ..control.params import FXTNTSMCParams, available_gain_presets, get_gain_preset
+from ..control.gain_presets import FXTNTSMCParams, available_gain_presets, get_gain_preset
 from ..environment.current import MAX_SAMPLES as MAX_CURRENT_SAMPLES
-from ..plant.presets import available, get_preset, is_reduced
-from ..plant.sixdof.presets import available6, load_preset6
-from ..plant.reduction import U0_MAX, U0_MIN, default_u0
+from ..vehicle.presets import available, get_preset, is_reduced
+from ..vehicle.truth_presets import available6, load_preset6
+from ..vehicle.reduction import U0_MAX, U0_MIN, default_u0
 from ..plant.sixdof.truth import actuator_values
 from ..reference import build_reference
 
@@ -167,7 +167,7 @@ class VehicleSection(_Section):
     number's source.
     """
 
-    preset: Str = Field("paper", description="one of auvtrack.plant.presets.available()")
+    preset: Str = Field("paper", description="one of auvtrack.vehicle.presets.available()")
     m: Mass5 | None = Field(None, description="m11, m22, m33 (kg), m44, m55 (kg m^2)")
     d: Coefficient5 | None = Field(None, description="d11, d22, d33 (N s/m), d44, d55 (N m s/rad)")
     wgml: Coefficient | None = Field(None, description="rho g nabla GM_L, N m")

@@ -44,10 +44,11 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from ..scenario import load_scenario, paper_scenario_path
-from ..simulation.api import compile_first, prepare, run_prepared
+from ..simulation.compiling import compile_first
+from ..simulation.pipeline import prepare, run_prepared
 from ..simulation.result import Result
 from .registry import StudySpec, kinds_in
-from .report import Report, failure_cause, fmt, write_json
+from ..report import Report, failure_cause, fmt, write_json
 
 ENVELOPE_KINDS = ("none", "rigid", "reactive", "proactive")
 ESTIMATOR_KINDS = ("none", "printed", "omega", "effective")

@@ -5,7 +5,7 @@ initial error (Theorem 1).  This study measures the settling time to 1 cm and to
 (``settle_1cm_*`` / ``settle_1mm_*``, the time after which every axis stays within the
 threshold) against the magnitude of the initial virtual-point error, over several decades and
 several directions, for the FXTNTSMC and the FTSMC, and draws Theorem 1's bounds
-(:func:`auvtrack.control.theory.fixed_time_bounds`) on the same log-log axes.
+(:func:`auvtrack.control.fxtntsmc.theory.fixed_time_bounds`) on the same log-log axes.
 
 Initial state: the vehicle starts at rest with Section 4's attitude (theta = psi = 0) and its
 virtual point at ``eta_d(0) + |e0| d`` (unit direction d), everything else as in Section 4.
@@ -27,14 +27,15 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..control.theory import fixed_time_bounds
-from ..plant.kinematics import attitude, j3_inv, virtual_point
+from ..control.fxtntsmc.theory import fixed_time_bounds
+from ..vehicle.kinematics import attitude, j3_inv, virtual_point
 from ..reference import build_reference
 from ..scenario import Scenario, load_scenario
-from ..simulation.api import compile_first, prepare, run_prepared, vehicle_arrays
+from ..simulation.compiling import compile_first
+from ..simulation.pipeline import prepare, run_prepared, vehicle_arrays
 from ..scenario import paper_scenario_path
 from .registry import StudySpec, kinds_in
-from .report import Report, failure_cause, fmt, write_json
+from ..report import Report, failure_cause, fmt, write_json
 
 VARIANTS: dict[str, tuple[str, ...]] = {
     "fxtntsmc": ("controller.kind=fxtntsmc",),

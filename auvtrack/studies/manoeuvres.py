@@ -156,8 +156,9 @@ def run(out, *, quick: bool = False, progress: bool = False):
     from matplotlib.figure import Figure
 
     from ..scenario import load_scenario
-    from ..simulation.api import compile_first, prepare, run_prepared
-    from .report import Report, write_json
+    from ..simulation.compiling import compile_first
+    from ..simulation.pipeline import prepare, run_prepared
+    from ..report import Report, write_json
 
     compile_first([("open_loop_actuators", "6dof")], progress=progress)
     out = Path(out)

@@ -34,7 +34,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from .registry import StudySpec
-from .report import Report, failure_cause, write_json
+from ..report import Report, failure_cause, write_json
 
 TRUTHS = {"5dof": None, "prestero": "remus100_prestero", "fossen": "remus100_fossen"}
 CURRENT = {"kind": "current", "mean": [0.2, 0.1, 0.0], "sigma": [0.05, 0.05, 0.0], "tau": 60.0}
@@ -156,7 +156,8 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
         The report's path.
     """
     from ..scenario import load_scenario
-    from ..simulation.api import compile_first, prepare, run_prepared
+    from ..simulation.compiling import compile_first
+    from ..simulation.pipeline import prepare, run_prepared
 
     compile_first([(c, p) for c in controllers() for p in ("5dof", "6dof")], progress=progress)
     out = Path(out)

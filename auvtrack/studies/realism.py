@@ -34,10 +34,10 @@ from typing import Callable
 from matplotlib.figure import Figure
 from tqdm.auto import tqdm
 
-from ..runner.batch import iter_batch, preferred_backend
-from ..simulation.api import compile_first
+from ..batch.runner import iter_batch, preferred_backend
+from ..simulation.compiling import compile_first
 from .registry import StudySpec
-from .report import Report, failure_cause, write_json
+from ..report import Report, failure_cause, write_json
 
 CONTROLLERS = ("fxtntsmc", "ftsmc")
 VEHICLES = ("paper", "remus100")  # vehicle presets; every other number is Section 4's
@@ -105,7 +105,7 @@ Job = tuple[str, str, str, float, list[str]]  # vehicle, controller, factor, lev
 
 def _prepare(job: Job):
     from ..scenario import load_scenario
-    from ..simulation.api import prepare
+    from ..simulation.pipeline import prepare
 
     vehicle, kind, _, _, overrides = job
     # the built-in defaults are Section 4; the preset then supplies every vehicle number

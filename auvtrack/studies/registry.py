@@ -45,7 +45,7 @@ class StudySpec:
 
 
 def kinds_in(overrides: Iterable[str]) -> list[str]:
-    """The controller kinds that ``controller.kind=...`` overrides name (for :func:`~auvtrack.simulation.api.compile_first`).
+    """The controller kinds that ``controller.kind=...`` overrides name (for :func:`~auvtrack.simulation.compiling.compile_first`).
 
     Parameters
     ----------

@@ -4,7 +4,7 @@ Runs the packaged Section 4 scenario with the FXTNTSMC and with the FTSMC baseli
 run folder for each, the paper's Figures 3-8 (PNG and PDF), a metrics table (Markdown and
 JSON) and a verdict on each of the paper's three claims computed from the measured numbers;
 ``summary.md`` and the self-contained ``report.html`` hold the same report
-(:class:`~auvtrack.studies.report.Report`).
+(:class:`~auvtrack.report.Report`).
 
 Every verdict states its conditions (estimator law, sliding surface, start treatment, envelope
 baseline, gains; :func:`conditions`).  Besides the corrected defaults the claims are judged for
@@ -24,13 +24,14 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from ..control.fxtntsmc import StartOutsideEnvelope
-from ..control.params import get_gain_preset
+from ..control.gain_presets import get_gain_preset
 from ..simulation import plotting
-from ..simulation.api import compile_first, prepare, run_prepared
+from ..simulation.compiling import compile_first
+from ..simulation.pipeline import prepare, run_prepared
 from ..simulation.result import Result
 from ..scenario import load_scenario
 from ..scenario import paper_scenario_path
-from .report import Report
+from ..report import Report
 
 CONTROLLERS = (("FXTNTSMC", "fxtntsmc"), ("FTSMC", "ftsmc"))
 # the same comparison with both controllers tuned by one procedure (docs/tuning.md)

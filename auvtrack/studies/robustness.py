@@ -13,7 +13,7 @@ seed, so a sample set is a pure function of ``(seed, n)``):
 
 Every controller configuration sees the *same* samples (common random numbers), on every
 vehicle preset of the configuration (``paper`` and ``remus100`` by default).  Runs go through
-:func:`auvtrack.runner.batch.run_batch` (threads over the ``nogil`` kernel).  The report
+:func:`auvtrack.batch.runner.run_batch` (threads over the ``nogil`` kernel).  The report
 gives, per vehicle and controller, the failure rate with the failures by cause, and the median
 and 95th percentile of the metrics over the runs that did not fail.
 """
@@ -28,10 +28,11 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..scenario import load_scenario
-from ..simulation.api import compile_first, prepare
-from ..runner.batch import run_batch
+from ..simulation.compiling import compile_first
+from ..simulation.pipeline import prepare
+from ..batch.runner import run_batch
 from .registry import StudySpec
-from .report import Report, failure_cause, write_json
+from ..report import Report, failure_cause, write_json
 
 __all__ = ["Sample", "RobustnessConfig", "CONTROLLERS", "draw_samples", "sample_scenario",
            "run_batch", "summarise", "run", "STUDY"]
@@ -295,7 +296,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False,
     pathlib.Path
         ``out/report.md``.
     """
-    from ..control.params import available_gain_presets
+    from ..control.gain_presets import available_gain_presets
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

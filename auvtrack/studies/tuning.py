@@ -34,12 +34,13 @@ import numpy as np
 from scipy.optimize import differential_evolution
 
 from ..control import get as get_controller
-from ..control.params import FXTNTSMCParams
-from ..control.theory import check_theorem1
+from ..control.gain_presets import FXTNTSMCParams
+from ..control.fxtntsmc.theory import check_theorem1
 from ..scenario import load_scenario
-from ..simulation.api import compile_first, prepare, run_prepared
+from ..simulation.compiling import compile_first
+from ..simulation.pipeline import prepare, run_prepared
 from .registry import StudySpec
-from .report import Report, write_json
+from ..report import Report, write_json
 
 __all__ = ["GainSpace", "Objective", "Case", "Budget", "SPACES", "TRAIN_CASES", "HELDOUT_CASES",
            "case_scenario", "run_cost", "tune", "evaluate", "preset_toml", "run", "STUDY"]
@@ -114,7 +115,7 @@ class GainSpace:
 # One-to-one counterparts: switching gain k1 <-> kappa1, linear reaching gain k2 <-> kappa3,
 # surface weight beta <-> a1, surface exponent gamma <-> alpha.  The FXTNTSMC box keeps every
 # condition of Theorem 1 (kappa3 > 0.5; 0.5 < alpha, a2 alpha < 1 and a4 alpha > 1 with the
-# paper's a2 = 0.8, a4 = 2); the objective re-checks them with auvtrack.control.theory.
+# paper's a2 = 0.8, a4 = 2); the objective re-checks them with auvtrack.control.fxtntsmc.theory.
 # The baselines tune their three loop gains (docs/controllers.md) in boxes spanning two decades or
 # more around the defaults (the integral and adaptation gains down to 1e-4, near switched off); the PID's ki >= kd kp and the STA's Moreno-Osorio condition
 # (with the default L) cut parts of their boxes, which setup refuses and the objective penalises.

@@ -41,7 +41,7 @@ def setup(scenario) -> CompiledPlant:
     ValueError
         ``initial.nu: ...`` when the initial surge speed is beyond the propeller's reach.
     """
-    from ..presets import vehicle_arrays
+    from ...vehicle.presets import vehicle_arrays
     from .setup import prepare_truth
 
     truth = prepare_truth(scenario, direct=scenario.controller.kind in DIRECT_KINDS)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from ..._jit import njit_noalloc
+from ...engine.jit import njit_noalloc
 from ...environment.current import current_velocity
 from ...environment.disturbances import add_paper, add_pulse
 from ...environment.layout import KIND_CURRENT, KIND_PAPER, KIND_PULSE

@@ -8,7 +8,7 @@ model at the measured speed (or passes actuator commands through for ``open_loop
 """
 from __future__ import annotations
 
-from ..._jit import njit_noalloc
+from ...engine.jit import njit_noalloc
 from . import prestero
 from .actuators import effective
 from .layout import CMD_TAU, LOG_NAMES6, N_CMD6, NX6, P_DIRECT

@@ -38,11 +38,11 @@ import math
 
 import numpy as np
 
-from ..._jit import njit_noalloc
+from ...engine.jit import njit_noalloc
 from .actuators import actuator_rates, clip, effective, fin_angle_for
 from .layout import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL, P_MRB, P_NMAX, P_RB,
                       P_RG, P_W, PP6_SIZE)
-from .presets import Preset6
+from ...vehicle.truth_presets import Preset6
 from .rigid import (body_from_ned6, check_spd, euler_rates, kirchhoff, matvec6, ned_velocity,
                      restoring, rigid_body_mass, trig_att)
 

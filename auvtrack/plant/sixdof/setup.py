@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .layout import LOG_NAMES6
-from .presets import load_preset6
+from ...vehicle.truth_presets import load_preset6
 from .truth import MODELS, initial_state, pack_truth, trim_rpm
 
 

@@ -14,10 +14,10 @@ from types import ModuleType
 import numpy as np
 
 from . import fossen, prestero
-from ..kinematics import attitude
+from ...vehicle.kinematics import attitude
 from .layout import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_MINV, P_NMAX, P_NRATE,
                       P_TDELTA, P_TN, PP6_SIZE)
-from .presets import Preset6, load_preset6
+from ...vehicle.truth_presets import Preset6, load_preset6
 
 MODELS: dict[str, ModuleType] = {"remus100_prestero": prestero, "remus100_fossen": fossen}
 

@@ -1,0 +1,1 @@
+"""The controller benchmark (``auvtrack compare``): suites, execution, statistics, leaderboard and report."""

@@ -1,0 +1,48 @@
+"""Command line: ``auvtrack reproduce | run | check | bounds | study | sweep | compare | bench | warmup``.
+
+Bad input (a scenario error, a missing file, an invalid gain, a run over the plan's limits, an
+output folder that cannot be written) prints ONE line to stderr and exits with status 2, never a
+traceback, and before anything runs.  ``check`` runs exactly the validation of ``run`` (load,
+plan, controller set-up), so it refuses the same scenarios with the same message.  A simulation
+that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
+prints the diagnostic and exits 3.  Ctrl-C stops a run within about a second, saves what was
+computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps its
+completed chunks for ``--resume`` and exits 130 (so does ``compare``).  ``auvtrack --help`` lists every command and
+these exit codes.
+"""
+from __future__ import annotations
+
+import warnings
+
+import click
+
+from . import compare, perf, run, studies, sweep  # noqa: F401  (each registers its commands on the group)
+from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_SIM_FAILED, cli, one_line
+
+__all__ = ["cli", "main", "EXIT_BAD_INPUT", "EXIT_SIM_FAILED", "EXIT_INTERRUPTED"]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``auvtrack`` console script; returns the exit status."""
+    from ..scenario import ScenarioError
+
+    warnings.simplefilter("default")
+    try:
+        rv = cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
+    except click.exceptions.Exit as e:
+        return e.exit_code
+    except click.UsageError as e:  # one line too, with where to look
+        where = f" (see '{e.ctx.command_path} --help')" if e.ctx is not None else ""
+        click.echo(f"auvtrack: error: {one_line(e.format_message())}{where}", err=True)
+        return EXIT_BAD_INPUT
+    except click.ClickException as e:
+        e.show()
+        return e.exit_code
+    except click.exceptions.Abort:  # Ctrl-C outside a simulation (loading, compiling, saving)
+        click.echo("auvtrack: interrupted", err=True)
+        return EXIT_INTERRUPTED
+    except (ScenarioError, ValueError, KeyError, OSError) as e:
+        click.echo(f"auvtrack: error: {one_line(e)}", err=True)
+        return EXIT_BAD_INPUT
+    # without standalone mode, click returns the code of a raised ``Exit`` instead of exiting
+    return rv if isinstance(rv, int) else 0

@@ -1,0 +1,95 @@
+"""Shared pieces of the command line: the ``auvtrack`` group, one-line errors, exit codes, options."""
+from __future__ import annotations
+
+import inspect
+
+import click
+
+EXIT_BAD_INPUT = 2
+EXIT_SIM_FAILED = 3
+EXIT_INTERRUPTED = 130
+MAX_WORKERS = 256
+MAX_REPEAT = 1000
+LONG_RUN_STEPS = 1_000_000  # runs this long announce themselves (and that Ctrl-C keeps their result)
+
+
+class BadInput(click.ClickException):
+    """Any user error: shown as one line, exit status 2."""
+
+    exit_code = EXIT_BAD_INPUT
+
+    def show(self, file=None) -> None:  # noqa: D102 - one line, no "Error:" banner
+        click.echo(f"auvtrack: error: {self.format_message()}", err=True)
+
+
+def load_arg(scenario: str, overrides: tuple[str, ...]):
+    from ..scenario import load_scenario
+
+    return load_scenario(scenario, list(overrides))
+
+
+def prepare_arg(scenario: str, sc):
+    """The run's validation after loading: plan and controller set-up (``check`` = ``run`` minus the run)."""
+    from ..simulation.pipeline import prepare
+
+    try:
+        return prepare(sc)
+    except ValueError as exc:  # ScenarioError of the plan, or a controller refusing its set-up
+        raise BadInput(f"{scenario}: {one_line(exc)}") from None
+
+
+def mib(n: int) -> str:
+    return f"{n / 2 ** 20:.3g} MiB"
+
+
+def one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+EXIT_CODES = (("0", "success"),
+              ("2", "bad input: one line naming the field and the allowed range, no traceback, nothing run"),
+              ("3", "a simulation failed (diverged, pitch limit, envelope violated): the diagnostic is printed "
+                    "and the partial result kept"),
+              ("130", "interrupted (Ctrl-C): a run keeps its partial result, a sweep or a comparison its "
+                      "completed chunks"))
+EXIT_CODES_HELP = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + "."
+COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "study", "sweep", "compare", "bench", "warmup")
+
+
+def _first_paragraph(text: str | None) -> str:
+    return " ".join(inspect.cleandoc(text or "").split("\n\n")[0].split())
+
+
+class _Group(click.Group):
+    """Top-level group: every command with its whole first help paragraph, then the exit codes."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        names = super().list_commands(ctx)
+        return [n for n in COMMAND_ORDER if n in names] + [n for n in names if n not in COMMAND_ORDER]
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(n, _first_paragraph(c.help)) for n in self.list_commands(ctx)
+                if (c := self.get_command(ctx, n)) is not None and not c.hidden]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+    def format_epilog(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        with formatter.section("Exit status"):
+            formatter.write_dl(list(EXIT_CODES))
+        super().format_epilog(ctx, formatter)
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="auvtrack")
+def cli() -> None:
+    """auvtrack: trajectory-tracking control of underactuated AUVs.
+
+    Scenarios are TOML files in which every key has a default (docs/scenarios.md); an empty
+    file is the paper's Section 4.  Start with `auvtrack reproduce`.  The first command after
+    installing or editing the package compiles the Numba kernels (about a minute, more on a
+    loaded machine; cached on disk afterwards); `auvtrack warmup` does that up front.
+    """
+
+
+set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
+                          help="Override a scenario key, e.g. --set sim.dt=0.002 (repeatable).")

@@ -1,0 +1,369 @@
+"""FXTNTSMC: the paper's fixed-time nonsingular terminal SMC (eq. 26-32, corrected).
+
+Per axis i, with z the transformed error of eq. (17) and the envelope of
+:mod:`auvtrack.control.fxtntsmc.envelopes`:
+
+    S   = z_dot + S1(S_e),  S_e = a1 sig^a2(z) + a3 sig^a4(z)                   (eq. 26, 28)
+    S1  = sig^alpha(S_e) if |S_e| > sigma, else beta1 S_e + beta2 sign(S_e) S_e^2   (eq. 27)
+    nu  = -kappa1 sign S - kappa2 sig^3 S - kappa3 S                            (reaching law)
+
+The input makes S_dot = nu + G (chi - chi_hat) (ERRATA 13, derivation in docs/derivation.md):
+from z_ddot = Omega_dot e_dot + Omega e_ddot - U_dot e - U e_dot with U_dot e = c0 + c1 e_ddot,
+
+    e_ddot* = [nu - S1_dot - Omega_dot e_dot + c0 + U e_dot] / G,  G = Omega - c1   (G^-1 on nu)
+    tau_bar = M_bar J3^-1 (e_ddot* - chi_hat - J3_dot v1 - J4_dot + eta_d_ddot) + C_bar v1 + D_bar v1 + G_bar
+
+where U_dot contains e_ddot itself (loop 2 of ERRATA 10), solved in closed form; G is the
+effective gain (= Omega outside the band of the risk monitor's gamma, where c1 = 0).
+The |z|^(a2-1) of S1_dot (ERRATA 12) is handled by ``surface``: "nonsingular" replaces
+sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the same device as
+eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
+
+Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels per axis: rho (envelope),
+rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger),
+zeta (z, the transformed error) and gain_ratio (G/Omega: the effective gain G = Omega - c1 with
+which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band).
+"""
+from __future__ import annotations
+
+
+from typing import Literal
+
+import numpy as np
+from pydantic import Field
+
+from ...engine.jit import njit, njit_noalloc
+from ...engine.vecmath import atanh4, pow4
+from . import envelopes
+from . import rbf
+from ..registry import CompiledController, ControllerParams
+from ..contract import WORK_SIZE
+from ..tracking import error_state_forces, input_for_accel_forces, sign
+
+NAME = "fxtntsmc"
+AXES = ("x", "y", "z")
+# channel names (formerly S_* and z_*, still readable: auvtrack/simulation/channels.py)
+AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding", "g", "zeta", "gain_ratio")
+                  for a in AXES)
+
+# Packed parameters cp (built by :func:`setup`):
+#   0-11   kappa1, kappa2, kappa3, a1, a2, a3, a4, alpha, sigma, surface code, z_switch, z_floor
+#   12     envelope kind;  13-26  the 14 envelope parameters of envelopes.axis_transform
+#   27-30  constants precomputed once (they only depend on gains): c1, c2 of the nonsingular
+#          quadratic (surface_coeffs) and beta1, beta2 of eq. (27) (switch_coeffs)
+#   31-33  estimator code, neurons m, RBF width;  34-  the 6 m RBF centres
+K1, K2, K3, A1, A2, A3, A4, ALPHA, SIGMA, SURF, ZSW, ZFL = range(12)
+ENV, EP0 = 12, 13  # envelope kind, then the 14 envelope parameters of envelopes.axis_transform
+SC1, SC2, SB1, SB2 = 27, 28, 29, 30
+EST, NEUR, WIDTH, CENT = 31, 32, 33, 34
+SURFACES = {"nonsingular": 0, "printed": 1}
+RHO_BAR, WEIGHTS = 0, 3  # internal state xc = [rho_bar (3), W (3 m)]
+MAX_NEURONS = WORK_SIZE  # the basis psi occupies work[0:m]
+
+
+class Params(ControllerParams):
+    """Fixed-time nonsingular terminal SMC of the paper (eq. 26-32, corrected per ERRATA 11-13).
+
+    Names follow the paper: ``a3 = b1`` and ``a4 = b2`` (ERRATA 11); ``varsigma1`` is the
+    approximation-error bound written "zeta1 = 0.05" in Section 4.
+    """
+
+    kind: Literal["fxtntsmc"] = "fxtntsmc"
+    kappa1: float = Field(0.005, gt=0, description="switching gain")
+    kappa2: float = Field(0.8, gt=0, description="cubic reaching gain")
+    kappa3: float = Field(0.6, gt=0, description="linear reaching gain")
+    a1: float = Field(0.8, gt=0)
+    a2: float = Field(0.8, gt=0, lt=1, description="fractional power, 0.5 <= a2 < 1 in Theorem 1")
+    a3: float = Field(0.8, gt=0, description="b1 of Theorem 1")
+    a4: float = Field(2.0, gt=1, description="b2 of Theorem 1")
+    alpha: float = Field(0.6, gt=0)
+    sigma: float = Field(0.005, gt=0, description="switch threshold of eq. (27)")
+    varsigma1: float = Field(0.05, gt=0, description="RBF approximation-error bound (Theorem 1)")
+    surface: Literal["nonsingular", "printed"] = Field(
+        "nonsingular",
+        description="'nonsingular': C1 switch on |z| replaces sig^a2 near 0 (ERRATA 12); "
+        "'printed': eq. (28) as printed, with |z| floored at z_floor",
+    )
+    z_switch: float = Field(0.01, gt=0, description="|z| below which the nonsingular switch is used")
+    z_floor: float = Field(1e-6, gt=0, description="floor on |z| in the printed form's |z|^(a2-1)")
+
+
+
+class StartOutsideEnvelope(ValueError):
+    """The initial error lies on or outside the envelope and the start treatment is off."""
+
+
+@njit
+def surface_coeffs(a2, zs):
+    """c1, c2 of the C1 quadratic c1 z + c2 sign(z) z^2 that replaces sig^a2(z) for |z| <= zs.
+
+    Matches value and slope of sig^a2 at |z| = zs (ERRATA 12); constant per run, so the
+    compiled law reads them from ``cp`` (packed by :func:`setup`).
+    """
+    return (2.0 - a2) * zs ** (a2 - 1.0), (a2 - 1.0) * zs ** (a2 - 2.0)
+
+
+@njit
+def switch_coeffs(alpha, sigma):
+    """beta1, beta2 of eq. (27): C1 at |S_e| = sigma (S_e dimensionless); constant per run (packed in ``cp``)."""
+    return (2.0 - alpha) * sigma ** (alpha - 1.0), (alpha - 1.0) * sigma ** (alpha - 2.0)
+
+
+@njit
+def power_below(x, p):
+    """x^(p-1), exactly x when p = 2 (x >= 0; x > 0 when p < 1)."""
+    return x if p == 2.0 else x ** (p - 1.0)
+
+
+@njit
+def pow_and_power_below(x, p):
+    """(x^p, x^(p-1)) with one pow: x^p = x x^(p-1), and x^(p-1) = x when p = 2.
+
+    x >= 0, and x > 0 when p < 1 (x^(p-1) is infinite at 0; callers stay away from 0 there).
+    """
+    q = power_below(x, p)
+    return x * q, q
+
+
+@njit_noalloc(inline="always")
+def powers_below3(x, p, need):
+    """:func:`power_below` of the bases ``x`` (3-tuple) for the lanes where ``need`` (3 booleans) is true.
+
+    Two or three needed powers take one vector call (:func:`auvtrack.engine.vecmath.pow4`), which
+    returns every lane within 4 ulp of :func:`power_below`; a single needed power is one scalar
+    call (exactly :func:`power_below`) and the other lanes are 1.  p = 2 returns the bases.
+    """
+    if p == 2.0:
+        return x
+    n = int(need[0]) + int(need[1]) + int(need[2])
+    if n >= 2:
+        q = p - 1.0
+        r = pow4((x[0], x[1], x[2], 1.0), (q, q, q, q))
+        return r[0], r[1], r[2]
+    q0 = power_below(x[0], p) if need[0] else 1.0
+    q1 = power_below(x[1], p) if need[1] else 1.0
+    q2 = power_below(x[2], p) if need[2] else 1.0
+    return q0, q1, q2
+
+
+SURF_QUADRATIC, SURF_POWER, SURF_FLOORED = 0, 1, 2
+
+
+@njit
+def surface_branch(az, printed, zs, zfloor):
+    """Which form of sig^a2(z) eq. (28) uses at |z| = az: quadratic, power, or floored (printed only)."""
+    if not printed and az <= zs:
+        return SURF_QUADRATIC
+    return SURF_POWER if az >= zfloor else SURF_FLOORED
+
+
+@njit
+def surface_q(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2, qa):
+    """:func:`surface` given the quadratic's (c1, c2) = surface_coeffs(a2, zs) and qa = power_below(|z|, a2).
+
+    qa is used only on the power branch (:func:`surface_branch`), so a caller may pass any value
+    elsewhere.
+    """
+    az = abs(z)
+    s = sign(z)
+    branch = surface_branch(az, printed, zs, zfloor)
+    if branch == SURF_QUADRATIC:
+        g, dg = c1 * z + c2 * s * z * z, c1 + 2.0 * c2 * az
+    elif branch == SURF_POWER:
+        g, dg = s * (az * qa), a2 * qa
+    else:
+        g, dg = s * az**a2, a2 * zfloor ** (a2 - 1.0)
+    pb, qb = pow_and_power_below(az, a4)
+    return a1 * g + a3 * s * pb, a1 * dg + a3 * a4 * qb
+
+
+@njit
+def surface_c(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2):
+    """:func:`surface` with the quadratic's coefficients (c1, c2) = surface_coeffs(a2, zs) given."""
+    return surface_q(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2, power_below(abs(z), a2))
+
+
+@njit
+def surface(z, a1, a2, a3, a4, printed, zs, zfloor):
+    """S_e(z) of eq. (28) and dS_e/dz, singular-free unless ``printed`` (ERRATA 12).
+
+    S_e = a1 sig^a2(z) + a3 sig^a4(z); "nonsingular": sig^a2 -> c1 z + c2 sign(z) z^2 for
+    |z| <= zs; "printed": |z|^(a2-1) -> max(|z|, zfloor)^(a2-1) in the derivative.
+    """
+    c1, c2 = surface_coeffs(a2, zs)
+    return surface_c(z, a1, a2, a3, a4, printed, zs, zfloor, c1, c2)
+
+
+@njit
+def switch_q(se, alpha, sigma, b1, b2, qs):
+    """:func:`switch` given (beta1, beta2) = switch_coeffs(alpha, sigma) and qs = power_below(|S_e|, alpha).
+
+    qs is used only where |S_e| > sigma.
+    """
+    a = abs(se)
+    if a > sigma:
+        return sign(se) * (a * qs), alpha * qs
+    return b1 * se + b2 * sign(se) * se * se, b1 + 2.0 * b2 * a
+
+
+@njit
+def switch_c(se, alpha, sigma, b1, b2):
+    """:func:`switch` with (beta1, beta2) = switch_coeffs(alpha, sigma) given."""
+    return switch_q(se, alpha, sigma, b1, b2, power_below(abs(se), alpha))
+
+
+@njit
+def switch(se, alpha, sigma):
+    """S1(S_e) of eq. (27) and its derivative; C1 at |S_e| = sigma.
+
+    S1 = sig^alpha(S_e) for |S_e| > sigma, else beta1 S_e + beta2 sign(S_e) S_e^2.
+    """
+    b1, b2 = switch_coeffs(alpha, sigma)
+    return switch_c(se, alpha, sigma, b1, b2)
+
+
+@njit
+def reaching_law(S, k1, k2, k3):
+    """nu = -kappa1 sign(S) - kappa2 sig^3(S) - kappa3 S of eq. (32), the desired S_dot (S in m/s, nu in m/s^2)."""
+    return -k1 * sign(S) - k2 * S * S * S - k3 * S
+
+
+@njit_noalloc(inline="always")
+def _transform(kind, shape, cp, eprm, e, ed, xc, i):
+    """Envelope and error transformation of axis ``i`` (eq. 17-25) with xi for z, :func:`envelopes.axis_transform_xi`."""
+    r1 = envelopes.axis_baseline(shape, cp, EP0, i)
+    return envelopes.axis_transform_xi(kind, e[i], ed[i], xc[RHO_BAR + i], eprm, r1)
+
+
+@njit_noalloc(inline="always")
+def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux):
+    """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27) and the commanded e_ddot (eq. 32, ERRATA 13).
+
+    Returns (S (m/s), e_ddot (m/s^2), Omega_i, G_i), G_i = Omega_i - c1_i the effective gain with
+    which chi enters S_dot (1/m, as Omega); writes dxc of rho_bar_i and the aux channels except
+    chi_hat, which the estimator's update of the three axes fills in afterwards.
+    """
+    _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
+    s1, dphi = switch_q(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2], qs)
+    S = zd + s1
+    reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
+    G = Om - c1  # > 0 (docs/derivation.md section 3)
+    edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / G
+    dxc[RHO_BAR + i] = rbd
+    aux[i], aux[3 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, S, g, z
+    aux[18 + i] = G / Om  # exactly 1 where c1 = 0
+    return S, edd, Om, G
+
+
+@njit_noalloc(inline="always")
+def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+    """Compiled FXTNTSMC law, eq. (26)-(34) corrected (tau in N, N m); status 1 if an error leaves its envelope.
+
+    ``work[0:m]`` holds the RBF basis.
+    """
+    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
+    kind, est, m = int(cp[ENV]), int(cp[EST]), int(cp[NEUR])
+    if est != rbf.NONE:
+        rbf.basis(e, ed, cp, CENT, m, cp[WIDTH], work)
+    printed = cp[SURF] != 0.0
+    # the baseline's exp(-t / (T - t)) is shared by the three axes (one T)
+    shape = envelopes.AFTER_T
+    if kind != envelopes.NONE:
+        shape = envelopes.baseline_shape(t, cp[EP0 + envelopes.EP_T])
+    eprm = envelopes.params(cp, EP0)
+    # three phases over the axes, so that atanh (eq. 17) and each power of eq. (27)-(28) is one vector call
+    st0, tr0 = _transform(kind, shape, cp, eprm, e, ed, xc, 0)
+    if st0 != 0:
+        return st0
+    st1, tr1 = _transform(kind, shape, cp, eprm, e, ed, xc, 1)
+    if st1 != 0:
+        return st1
+    st2, tr2 = _transform(kind, shape, cp, eprm, e, ed, xc, 2)
+    if st2 != 0:
+        return st2
+    xi = (tr0[0], tr1[0], tr2[0])  # e / rho, or e itself without an envelope (then z = e)
+    z = xi
+    if kind != envelopes.NONE:
+        zv = atanh4((xi[0], xi[1], xi[2], 0.0))  # z = atanh(xi), eq. (17)
+        z = (zv[0], zv[1], zv[2])
+    az = (abs(z[0]), abs(z[1]), abs(z[2]))
+    need = (surface_branch(az[0], printed, cp[ZSW], cp[ZFL]) == SURF_POWER,
+            surface_branch(az[1], printed, cp[ZSW], cp[ZFL]) == SURF_POWER,
+            surface_branch(az[2], printed, cp[ZSW], cp[ZFL]) == SURF_POWER)
+    qz = powers_below3(az, cp[A2], need)
+    se0, dse0 = surface_q(z[0], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[0])
+    se1, dse1 = surface_q(z[1], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[1])
+    se2, dse2 = surface_q(z[2], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[2])
+    ase = (abs(se0), abs(se1), abs(se2))
+    qs = powers_below3(ase, cp[ALPHA], (ase[0] > cp[SIGMA], ase[1] > cp[SIGMA], ase[2] > cp[SIGMA]))
+    S0, edd0, om0, G0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux)
+    S1, edd1, om1, G1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux)
+    S2, edd2, om2, G2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux)
+    chat = (0.0, 0.0, 0.0)
+    if est != rbf.NONE:
+        gain = (1.0, 1.0, 1.0)  # printed eq. (34)
+        if est == rbf.OMEGA:
+            gain = (om0, om1, om2)
+        elif est == rbf.EFFECTIVE:
+            gain = (G0, G1, G2)
+        chat = rbf.estimate_and_adapt3(xc, WEIGHTS, m, work, (S0, S1, S2), gain, dxc)
+    aux[6], aux[7], aux[8] = chat
+    acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])
+    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, acc, gf)
+    return 0
+
+
+def start_widening(e0, rho1_0, xi0: float, widen: bool) -> tuple[np.ndarray, list[str]]:
+    """Initial rho_bar (ERRATA 9): rho_bar_i(0) = max(0, |e_i(0)| / xi0 - rho1_i(0)).
+
+    Widening applies on every axis where |e_i(0)| / rho1_i(0) > xi0 and is reported; with
+    ``widen`` false a start on or outside the envelope (ratio >= 1) raises
+    :class:`StartOutsideEnvelope` and a start inside it is left as it is.
+    """
+    rb = np.zeros(3)
+    notes = []
+    for i, a in enumerate(AXES):
+        ratio = abs(e0[i]) / rho1_0[i]
+        if widen and ratio > xi0:
+            rb[i] = abs(e0[i]) / xi0 - rho1_0[i]
+            notes.append(
+                f"envelope: start at |e_{a}(0)|/rho1_{a}(0) = {ratio:.4g} (>= xi0 = {xi0}); "
+                f"rho_bar_{a}(0) widened by {rb[i]:.6g} m so that |e_{a}(0)|/rho_{a}(0) = {xi0}"
+            )
+        elif not widen and ratio >= 1.0:
+            raise StartOutsideEnvelope(
+                f"envelope: the start lies on or outside the envelope on axis {a} "
+                f"(|e_{a}(0)| = {abs(e0[i]):.6g} m >= rho_{a}(0) = {rho1_0[i]:.6g} m); "
+                "set envelope.widen_start = true or enlarge envelope.rho0"
+            )
+    return rb, notes
+
+
+def setup(scenario, ctx) -> CompiledController:
+    """Pack gains, envelope and network of the scenario; apply the start treatment."""
+    p, env, est = scenario.controller, scenario.envelope, scenario.estimator
+    kind = envelopes.ENVELOPES[env.kind]
+    rho0, rho_inf = np.asarray(env.rho0, float), np.asarray(env.rho_inf, float)
+    printed = env.baseline == "printed"
+    notes: list[str] = []
+    rb0 = np.zeros(3)
+    if kind != envelopes.NONE:
+        rho1_0 = np.array([envelopes.baseline(0.0, rho0[i], rho_inf[i], env.T, printed)[0] for i in range(3)])
+        rb0, notes = start_widening(ctx.e0, rho1_0, env.xi0, env.widen_start)
+    m = est.neurons if est.kind != "none" else 0
+    if m > MAX_NEURONS:
+        raise ValueError(f"estimator.neurons: at most {MAX_NEURONS} (got {m})")
+    centres, weights = rbf.draw_network(ctx.seed, m, est.centre_range, est.weight_range)
+    cp = np.concatenate([
+        [p.kappa1, p.kappa2, p.kappa3, p.a1, p.a2, p.a3, p.a4, p.alpha, p.sigma,
+         SURFACES[p.surface], p.z_switch, p.z_floor, kind,
+         env.T, env.delta, env.epsilon, env.lambda1, env.lambda2, env.lambda3, env.reactive_threshold,
+         float(printed)], rho0, rho_inf,
+        surface_coeffs(p.a2, p.z_switch), switch_coeffs(p.alpha, p.sigma),
+        [rbf.ESTIMATORS[est.kind], m, est.width], centres.ravel(),
+    ]).astype(np.float64)
+    assert cp.size == CENT + 6 * m and cp[EST] == rbf.ESTIMATORS[est.kind]
+    xc0 = np.concatenate([rb0, weights.ravel()])
+    resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
+    return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),
+                              resolved=resolved)

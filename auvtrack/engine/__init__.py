@@ -1,0 +1,1 @@
+"""The compiler behind one seam: the RK4 loop, kernel generation and caching, JIT settings, vector math and SIMD lanes."""

@@ -1,0 +1,152 @@
+"""Compilation settings shared by every compiled kernel.
+
+Numba's on-disk cache is keyed by the timestamp of the file that defines a function, not by the
+files it calls, so editing ``plant/dynamics.py`` would leave a stale cached ``simulation/engine.py``
+kernel.  We therefore place the cache in a directory named by a hash of *all* package sources:
+any source change selects a fresh directory.  The name also carries the vector-math back end of
+:mod:`auvtrack.engine.vecmath` and whether the lane kernels use its 8-lane AVX-512 functions (compiled code
+differs between them).  Set ``AUVTRACK_CACHE_DIR`` to
+override the root.
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import types as pytypes
+from pathlib import Path
+
+import numba
+from numba.core import errors, types
+from numba.core.registry import CPUDispatcher
+
+from . import lane_values as _lanes  # noqa: F401  (_lanes: lane types registered before anything compiles)
+from . import vecmath as _vecmath  # noqa: F401  (_lanes: lane types registered before anything compiles)
+
+_PKG = Path(__file__).resolve().parents[1]  # the whole package: any edit selects a fresh cache
+
+
+@functools.lru_cache(maxsize=None)
+def source_hash() -> str:
+    """Return a SHA-256 digest of every ``*.py`` file of the package (paths and contents).
+
+    Computed once per process (Numba does not reload edited sources in a running process either).
+    """
+    h = hashlib.sha256()
+    for path in sorted(_PKG.rglob("*.py")):
+        h.update(str(path.relative_to(_PKG)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def cache_dir() -> Path:
+    """Return the numba cache directory for the current package sources."""
+    root = Path(os.environ.get("AUVTRACK_CACHE_DIR", Path.home() / ".cache" / "auvtrack"))
+    wide = "-avx512" if _vecmath.WIDE else ""  # the lane kernels' 8-lane libmvec calls (AUVTRACK_LIBMVEC_AVX512)
+    return root / f"numba-{numba.__version__}-{source_hash()[:16]}-{_vecmath.BACKEND}{wide}"
+
+
+numba.config.CACHE_DIR = str(cache_dir())
+LLVM_INLINE = os.environ.get("AUVTRACK_LLVM_INLINE", "1") != "0"
+
+
+class PlainArgsDispatcher(CPUDispatcher):
+    """A CPU dispatcher that compiles a call from compiled code for the non-literal argument types.
+
+    Numba types a constant argument as a literal (``Literal[int](0)``, ``Literal[bool](True)``)
+    and compiles the callee once per literal value: ``stage(..., True)`` and
+    ``stage(..., not reuse)`` were two compilations of the whole stage with the law inlined, a
+    counter starting at 0 another copy of ``log_row``, ``axis_baseline(..., i)`` three
+    (``benchmarks/profile.md``).  This dispatcher compiles the plain types (``int64``, ``bool``)
+    instead, once; a callee that only types with a literal (e.g. indexing a heterogeneous tuple
+    by it) still gets its literal specialisation.  Functions inlined by Numba
+    (``inline="always"``) are not dispatcher calls and keep seeing literals.
+    """
+
+    def get_call_template(self, args, kws):
+        """Resolve a call for the unliteral argument types (falling back to the literal ones)."""
+        plain = tuple(types.unliteral(a) for a in args)
+        plain_kws = {k: types.unliteral(v) for k, v in kws.items()}
+        if plain != tuple(args) or plain_kws != kws:
+            try:
+                return super().get_call_template(plain, plain_kws)
+            except errors.TypingError:
+                pass
+        return super().get_call_template(args, kws)
+
+
+def _plain(disp):
+    if isinstance(disp, CPUDispatcher) and type(disp) is CPUDispatcher:
+        disp.__class__ = PlainArgsDispatcher
+    return disp
+
+
+def njit(*args, **kwargs):
+    """``numba.njit`` with the project's defaults: on-disk cache, NumPy error model (1/0 -> inf).
+
+    Calls from compiled code compile the callee for plain (non-literal) argument types
+    (:class:`PlainArgsDispatcher`).
+    """
+    kwargs.setdefault("cache", True)
+    kwargs.setdefault("error_model", "numpy")
+    if kwargs.get("inline") == "always" and LLVM_INLINE:
+        kwargs.pop("inline")
+        kwargs["forceinline"] = True
+    out = numba.njit(*args, **kwargs)
+    if args and callable(args[0]):
+        return _plain(out)
+    return lambda fn: _plain(out(fn))
+
+
+def njit_noalloc(*args, **kwargs):
+    """:func:`njit` for hot-path functions that never allocate: no reference counting.
+
+    Numba increments and decrements the reference count of every array argument on entry and
+    exit of a compiled function (an atomic operation each); for the small functions called at
+    every RK4 stage this cost more than their arithmetic (FXTNTSMC 2.9 -> 2.0 us per step, FTSMC
+    2.3 -> 1.1, results bit-identical).  ``_nrt=False`` (a private Numba option) compiles the
+    function without the runtime: an allocation added to it fails to compile instead of leaking.
+    Remove the option here to revert every such function at once.
+    """
+    kwargs["_nrt"] = False
+    return njit(*args, **kwargs)
+
+
+_LLVM_INLINE: dict = {}
+
+
+def llvm_inline(disp):
+    """A copy of the compiled function ``disp`` that LLVM, not Numba, inlines into its callers.
+
+    ``inline="always"`` makes Numba copy a function's typed IR into every caller, and type and
+    lower each copy again; for a law of a few hundred lines inlined into two callers that was most
+    of a kernel's compile time (``benchmarks/profile.md``).  The copy returned here is compiled once
+    (``inline="never"``) and marked ``alwaysinline`` for LLVM (Numba's ``forceinline``), so each
+    caller still gets the law's code in its own body, from one compilation.  Same operations,
+    same numbers.  The copy is a distinct function (its own qualified name, hence its own cache
+    files: Numba's cache key does not include the compile options) and is made once per process.
+
+    Parameters
+    ----------
+    disp : numba dispatcher
+        A function compiled with :func:`njit` or :func:`njit_noalloc`.
+
+    Returns
+    -------
+    numba dispatcher
+        The LLVM-inlined copy.
+    """
+    got = _LLVM_INLINE.get(disp)
+    if got is not None:
+        return got
+    fn = disp.py_func
+    copy = pytypes.FunctionType(fn.__code__, fn.__globals__, fn.__name__, fn.__defaults__, fn.__closure__)
+    copy.__qualname__ = fn.__qualname__ + "__llvm_inline"
+    copy.__module__ = fn.__module__
+    copy.__doc__ = fn.__doc__
+    options = {k: v for k, v in disp.targetoptions.items() if k not in ("inline", "nopython", "boundscheck")}
+    options.pop("cache", None)
+    options["forceinline"] = True
+    out = njit(**options)(copy)
+    _LLVM_INLINE[disp] = out
+    return out

@@ -1,0 +1,438 @@
+"""Compiled closed loop: a plant, the environment, a reference and a controller under fixed-step RK4.
+
+The plant state ``xp`` (the plant module's ``NX`` states) and the controller's internal state
+``xc`` (adaptive weights, envelope filters, integrators) are integrated together.  Two modes:
+
+* continuous (``ctrl_every = 0``): the controller and the plant's allocation are evaluated at
+  every RK4 stage;
+* sampled-data (``ctrl_every = k``): they run every k steps on the measured state, and the
+  actuator command and the controller's state derivative are held (zero-order hold) until the
+  next sample.  The controller sees the plant's 5-DOF pose plus row k of the seeded noise table.
+
+Logs and metrics always use the true state and the input the plant actually produces.  One row
+is logged every ``log_every`` steps into a preallocated array (O(N) in total).  After every step
+the state is checked; a failure stops the run at once and keeps what was logged.  Every 1024
+steps the loop reads ``info[INFO_STOP]``: a non-zero value (set from another thread, e.g. on
+Ctrl-C) stops the run with cause :data:`CAUSE_INTERRUPTED`.
+
+**How the kernels are made.**  The functions marked ``@kernel_part`` below call the controller's
+compiled law as ``law(...)`` and the plant's compiled functions as ``plant.f(...)`` (the
+contracts: :mod:`auvtrack.control.contract`, ``docs/architecture.md``).  They are not compiled
+here: :mod:`auvtrack.engine.kernels` writes, for each (controller, plant) pair a run needs, a
+module that binds ``law`` and ``plant`` and holds a verbatim copy of these functions, and
+compiles it once (cached on disk).  This file is the one source of the loop.
+
+Arguments come in bundles (:class:`PlantBundle`, :class:`ControllerBundle`,
+:class:`EnvironmentBundle`, :class:`Settings`, :class:`Outputs`); integer settings ``si`` and
+float settings ``sf`` use the index constants below.
+
+Performance note: arrays are passed whole and indexed, never sliced, in the hot path (a slice
+is a reference-counted view whose atomic inc/decrements cost more than the arithmetic).
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import prange
+
+from .jit import njit, njit_noalloc
+from ..control.contract import WORK_SIZE
+from ..control.tracking import lumped_disturbance
+from ..environment.layout import KIND_PAPER, KIND_PULSE
+from ..environment.sensors import measure
+from ..plant.contract import CAUSE_PITCH, CAUSE_ROLL, SCRATCH_SIZE, SF_PHI_LIM, SF_THETA_LIM
+from ..vehicle.dynamics import nu_dot
+from ..vehicle.kinematics import attitude, virtual_point
+from ..vehicle.params import ELL
+from ..reference import eval_reference
+from ..simulation.metrics import metrics_update, saturation_update
+
+SI_NSTEPS, SI_LOG_EVERY, SI_CTRL_EVERY, SI_NAUX = range(4)
+SI_SIZE = 4
+SF_DT, SF_STATE_LIM, SF_WIN_T0, SF_WIN_T1 = 0, 2, 3, 4
+SF_SIZE = 6  # [dt, theta_lim, state_lim, t0, t1, phi_lim]; theta_lim, phi_lim: plant.contract
+assert SF_THETA_LIM == 1 and SF_PHI_LIM == 5
+INFO_STOP, INFO_STEPS = 0, 1
+INFO_SIZE = 2
+STOP_POLL = 1024  # steps between two reads of the stop flag (a power of two)
+
+# logged row: t, eta(5), nu(5), tau(3), eta_d(3), e(3), aux(naux), chi(3), plant channels(N_LOG)
+N_BASE_COLS = 20
+
+CAUSE_NONE, CAUSE_NONFINITE, CAUSE_STATE_LIMIT, CAUSE_INTERRUPTED = 0, 1, 3, 4
+CAUSE_CONTROLLER = 10  # + controller status code
+CAUSES = {
+    CAUSE_NONFINITE: ("nonfinite", "non-finite state (NaN or Inf)"),
+    CAUSE_PITCH: ("pitch_limit", "pitch limit exceeded (|theta| beyond sim.theta_limit)"),
+    CAUSE_STATE_LIMIT: ("state_limit", "state limit exceeded (divergence, |state| > sim.state_limit)"),
+    CAUSE_INTERRUPTED: ("interrupted", "interrupted by the user (Ctrl-C) or a stop request"),
+    CAUSE_ROLL: ("roll_limit", "roll limit exceeded (|phi| beyond sim.phi_limit)"),
+}
+"""Stop causes other than a controller status: code -> (name, detail)."""
+STATUS_NONFINITE_INPUT = 3
+
+
+class PlantBundle(NamedTuple):
+    """The true plant: packed parameters ``pp`` and initial state ``x0`` (plant module layout)."""
+
+    pp: np.ndarray
+    x0: np.ndarray
+
+
+class ControllerBundle(NamedTuple):
+    """The controller: packed gains ``cp``, initial internal state ``x0``, nominal vehicle ``vp``."""
+
+    cp: np.ndarray
+    x0: np.ndarray
+    vp: np.ndarray
+
+
+class EnvironmentBundle(NamedTuple):
+    """Disturbance tables ``rows`` and ``current`` (:mod:`auvtrack.environment`), sensor ``noise``."""
+
+    rows: np.ndarray
+    current: np.ndarray
+    noise: np.ndarray
+
+
+class Settings(NamedTuple):
+    """Integer settings ``si`` (SI_*) and float settings ``sf`` (SF_*)."""
+
+    si: np.ndarray
+    sf: np.ndarray
+
+
+class Outputs(NamedTuple):
+    """Written by the kernel.
+
+    ``log`` (n_rows, n_channels); ``acc`` the metrics accumulator; ``fail_state`` (2, nxp + nxc):
+    row 0 the state at the stop, row 1 the last finite state (the state at the start of the
+    failing step); ``info`` int64 (INFO_*): the stop request (read) and the steps run (written).
+    """
+
+    log: np.ndarray
+    acc: np.ndarray
+    fail_state: np.ndarray
+    info: np.ndarray
+
+
+KERNEL_PARTS: dict[str, str] = {}
+"""Name of each kernel part -> the decorator it is compiled with in a generated kernel module."""
+LANE_PARTS: dict[str, str] = {}
+"""The same for the parts of the SIMD batch module of a pair (:func:`run_lanes`)."""
+LANES = 8
+"""Runs per block of the lane kernels: the float64 lanes of one 512-bit AVX-512 register (two AVX2 registers)."""
+
+
+def kernel_part(decorator: str, *, lanes: bool = False):
+    """Mark a function as part of the loop that :mod:`auvtrack.engine.kernels` copies per (law, plant).
+
+    Parameters
+    ----------
+    decorator : str
+        Python source of the decorator the copy gets, e.g. ``"njit(nogil=True)"``.
+    lanes : bool, optional
+        A part of the SIMD batch module (compiled only when that back end runs) instead of the
+        kernel module.
+
+    Returns
+    -------
+    callable
+        A decorator that records the function and returns it unchanged (not compiled here).
+    """
+    def mark(fn):
+        (LANE_PARTS if lanes else KERNEL_PARTS)[fn.__name__] = decorator
+        return fn
+    return mark
+
+
+def example_arguments() -> tuple:
+    """Arguments of ``run`` with the exact types every prepared run passes (to compile ahead of time).
+
+    Every array is C-contiguous and writeable: float64 except the int64 ``si`` and ``info``.
+    """
+    f1, f2 = np.zeros(1), np.zeros((1, 1))
+    return (PlantBundle(f1, f1), ControllerBundle(f1, f1, f1), EnvironmentBundle(f2, f2, f2), f1,
+            Settings(np.zeros(SI_SIZE, np.int64), np.zeros(SF_SIZE)),
+            Outputs(f2, f1, f2, np.zeros(INFO_SIZE, np.int64)))
+
+
+# ------------------------------------------------------------------ helpers (compiled here)
+
+@njit
+def state_free_disturbance(d_rows):
+    """True when omega depends on time only (paper and pulse components), not on the state."""
+    for k in range(d_rows.shape[0]):
+        if d_rows[k, 0] != KIND_PAPER and d_rows[k, 0] != KIND_PULSE:
+            return False
+    return True
+
+
+@njit_noalloc
+def finite3(v):
+    """True when the three entries of ``v`` are finite."""
+    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
+
+
+@njit_noalloc(inline="always")
+def scan_state(x, state_lim):
+    """(any non-finite, any |x_i| > state_lim) over one state array, one pass."""
+    nonfinite = over = False
+    for i in range(x.shape[0]):
+        v = x[i]
+        if not math.isfinite(v):
+            nonfinite = True
+        elif abs(v) > state_lim:
+            over = True
+    return nonfinite, over
+
+
+@njit
+def record_stop(xp, xc, xp_last, xc_last, fail_state):
+    """Rows of ``fail_state``: the state [xp, xc] at the stop and the last finite state [xp_last, xc_last]."""
+    n = xp.shape[0]
+    for i in range(n):
+        fail_state[0, i], fail_state[1, i] = xp[i], xp_last[i]
+    for i in range(xc.shape[0]):
+        fail_state[0, n + i], fail_state[1, n + i] = xc[i], xc_last[i]
+
+
+# ------------------------------------------------------------------ kernel parts (compiled per law, plant)
+
+@kernel_part("njit_noalloc(inline='always')")
+def state_cause(xp, xc, sf):
+    """Failure cause after a step (precedence: non-finite, the plant's attitude limits, state limit)."""
+    nf_p, over_p = scan_state(xp, sf[SF_STATE_LIM])
+    nf_c, over_c = scan_state(xc, sf[SF_STATE_LIM])
+    nonfinite, over = nf_p or nf_c, over_p or over_c
+    if nonfinite:
+        return CAUSE_NONFINITE
+    cause = plant.attitude_cause(xp, sf)  # noqa: F821  (bound per kernel)
+    if cause != CAUSE_NONE:
+        return cause
+    if over:
+        return CAUSE_STATE_LIMIT
+    return CAUSE_NONE
+
+
+@kernel_part("njit_noalloc(inline='always')")
+def plant_attitude(xp):
+    """(cos theta, sin theta, cos psi, sin psi) of the plant state, through its 5-DOF ``pose``."""
+    eta = plant.pose(xp)[0]  # noqa: F821  (bound per kernel)
+    return attitude(eta[3], eta[4])
+
+
+@kernel_part("njit_noalloc")
+def stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd, dxp, dxc, tau, aux,
+          fresh):
+    """One right-hand-side evaluation: write dxp (and dxc); return (controller status, saturation flags).
+
+    ``att`` is the attitude of ``xp`` (computed once per stage by the caller).  In continuous
+    mode the law and the plant's allocation run here (``cmd`` is the previous command when the
+    allocation starts and the new one after it); in sampled-data mode ``cmd`` holds the sample's
+    command and the caller has filled dxc with the held controller derivative.  With ``fresh``
+    false the reference and the plant's cached disturbance of the previous call are reused: the
+    loop passes false only for the second of two stages at the same time whose disturbance does
+    not depend on the state (RK4 stages 2 and 3), so the values are the same numbers.
+    """
+    if fresh:
+        eval_reference(ref_p, t, refm)
+    flags = 0
+    if ctrl_every == 0:
+        eta, nu = plant.pose(xp)  # noqa: F821
+        status = law(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work)  # noqa: F821
+        if status != 0:
+            return status, flags
+        flags = plant.allocate((tau[0], tau[1], tau[2]), eta, nu, xp, pp, cmd, 0.0, cmd)  # noqa: F821
+    plant.rhs(t, xp, att, cmd, (rows, current), pp, scr, fresh, dxp)  # noqa: F821
+    return 0, flags
+
+
+@kernel_part("njit_noalloc")
+def control_sample(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+    """The law at one control sample (sampled-data mode), behind a call.
+
+    A law compiled with ``inline="always"`` is copied into every function that calls it; called
+    from here, :func:`run` holds no copy of its own (the law is inlined into :func:`stage`, where
+    it runs at every stage, and here), which halves what Numba compiles of it.  Once per sample,
+    the call costs nothing measurable.
+    """
+    return law(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work)  # noqa: F821
+
+
+@kernel_part("njit")
+def log_row(log, row, t, xp, cmd, pp, tau, refm, e, aux, naux, dxp, vp):
+    """Fill one logged row (see N_BASE_COLS); chi uses the nominal model with the produced input."""
+    eta, nu = plant.pose(xp)  # noqa: F821
+    log[row, 0] = t
+    for i in range(5):
+        log[row, 1 + i] = eta[i]
+        log[row, 6 + i] = nu[i]
+    for i in range(3):
+        log[row, 11 + i] = tau[i]
+        log[row, 14 + i] = refm[0, i]
+        log[row, 17 + i] = e[i]
+    for i in range(naux):
+        log[row, 20 + i] = aux[i]
+    att = attitude(eta[3], eta[4])
+    dnu_nom = nu_dot(att, nu, tau, (0.0, 0.0, 0.0, 0.0, 0.0), vp)
+    chi = lumped_disturbance(att, plant.accel5(dxp), dnu_nom, vp[ELL])  # noqa: F821
+    log[row, 20 + naux], log[row, 21 + naux], log[row, 22 + naux] = chi
+    plant.log_extra(xp, cmd, pp, log, row, 23 + naux)  # noqa: F821
+
+
+@kernel_part("njit(nogil=True)")
+def run(pb, cb, env, ref_p, settings, out):
+    """Integrate the closed loop; return (cause, rows_logged, t_stop).
+
+    ``out.log`` has shape (n_rows, N_BASE_COLS + naux + 3 + plant.N_LOG); ``out.acc`` is the
+    metrics accumulator (initialised by :func:`~auvtrack.simulation.metrics.metrics_init`).
+    """
+    si, sf = settings.si, settings.sf
+    log, acc, fail_state, info = out.log, out.acc, out.fail_state, out.info
+    pp, cp, vp = pb.pp, cb.cp, cb.vp
+    rows, current = env.rows, env.current
+    nxp, nxc = pb.x0.shape[0], cb.x0.shape[0]
+    n_steps, log_every, ctrl_every = si[SI_NSTEPS], si[SI_LOG_EVERY], si[SI_CTRL_EVERY]
+    naux = si[SI_NAUX]
+    dt = sf[SF_DT]
+    xp, xc = pb.x0.copy(), cb.x0.copy()
+    xpn, xcn = np.empty(nxp), np.empty(nxc)  # the state after a step, checked before it is taken
+    xps, xcs = np.empty(nxp), np.empty(nxc)
+    kp1, kp2, kp3, kp4 = np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp)
+    kc1, kc2, kc3, kc4 = np.zeros(nxc), np.zeros(nxc), np.zeros(nxc), np.zeros(nxc)
+    refm, work, scr = np.zeros((3, 3)), np.zeros(WORK_SIZE), np.zeros(SCRATCH_SIZE)
+    cmd, cmd_sample = np.zeros(plant.N_CMD), np.zeros(plant.N_CMD)  # noqa: F821
+    sat = 0  # saturation flags of the command in force
+    tau1, tau = np.zeros(3), np.zeros(3)
+    aux1, aux = np.zeros(max(naux, 1)), np.zeros(max(naux, 1))
+    reuse = state_free_disturbance(env.rows)  # stage 3 may reuse stage 2's reference and omega
+    row = 0
+    info[INFO_STEPS] = 0
+    for k in range(n_steps + 1):
+        t = k * dt
+        if (k & (STOP_POLL - 1)) == 0 and info[INFO_STOP] != 0:
+            record_stop(xp, xc, xp, xc, fail_state)
+            return CAUSE_INTERRUPTED, row, t
+        if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, allocate, hold
+            eval_reference(ref_p, t, refm)
+            eta_t, nu_t = plant.pose(xp)  # noqa: F821
+            eta, nu = measure(eta_t, nu_t, env.noise, k // ctrl_every)
+            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, refm, vp, cp, tau1, kc1, aux1, work)
+            if status == 0 and not finite3(tau1):
+                status = STATUS_NONFINITE_INPUT
+            if status != 0:
+                record_stop(xp, xc, xp, xc, fail_state)
+                return CAUSE_CONTROLLER + status, row, t
+            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt,  # noqa: F821
+                                 cmd_sample)
+            for i in range(cmd_sample.shape[0]):
+                cmd[i] = cmd_sample[i]
+            for i in range(nxc):  # the held controller derivative, for every stage until the next sample
+                kc2[i] = kc3[i] = kc4[i] = kc1[i]
+        # stage 1 at (t, x): also the values that are logged and enter the metrics
+        att = plant_attitude(xp)
+        status, flags = stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd,
+                              kp1, kc1, tau1, aux1, True)
+        if ctrl_every == 0:
+            sat = flags
+        if status == 0 and ctrl_every == 0 and not finite3(tau1):
+            status = STATUS_NONFINITE_INPUT
+        if status != 0:
+            record_stop(xp, xc, xp, xc, fail_state)
+            return CAUSE_CONTROLLER + status, row, t
+        applied = plant.applied(xp, cmd, pp)  # noqa: F821
+        eta, nu = plant.pose(xp)  # noqa: F821
+        p1 = virtual_point(eta, att, vp[ELL])
+        e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
+        if k % log_every == 0 and row < log.shape[0]:
+            log_row(log, row, t, xp, cmd, pp, applied, refm, e, aux1, naux, kp1, vp)
+            row += 1
+        if k == n_steps:
+            break
+        metrics_update(acc, t, dt, e, applied, sf[SF_WIN_T0], sf[SF_WIN_T1])
+        saturation_update(acc, t, dt, sat, sf[SF_WIN_T0], sf[SF_WIN_T1])
+        for i in range(nxp):
+            xps[i] = xp[i] + 0.5 * dt * kp1[i]
+        for i in range(nxc):
+            xcs[i] = xc[i] + 0.5 * dt * kc1[i]
+        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p, rows,
+                          current, refm, work, scr, cmd, kp2, kc2, tau, aux, True)
+        if status == 0:
+            for i in range(nxp):
+                xps[i] = xp[i] + 0.5 * dt * kp2[i]
+            for i in range(nxc):
+                xcs[i] = xc[i] + 0.5 * dt * kc2[i]
+            status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p,
+                              rows, current, refm, work, scr, cmd, kp3, kc3, tau, aux, not reuse)
+        if status == 0:
+            for i in range(nxp):
+                xps[i] = xp[i] + dt * kp3[i]
+            for i in range(nxc):
+                xcs[i] = xc[i] + dt * kc3[i]
+            status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p, rows,
+                              current, refm, work, scr, cmd, kp4, kc4, tau, aux, True)
+        if status != 0:
+            record_stop(xp, xc, xp, xc, fail_state)
+            return CAUSE_CONTROLLER + status, row, t
+        for i in range(nxp):
+            xpn[i] = xp[i] + dt / 6.0 * (kp1[i] + 2.0 * kp2[i] + 2.0 * kp3[i] + kp4[i])
+        for i in range(nxc):
+            xcn[i] = xc[i] + dt / 6.0 * (kc1[i] + 2.0 * kc2[i] + 2.0 * kc3[i] + kc4[i])
+        info[INFO_STEPS] = k + 1
+        cause = state_cause(xpn, xcn, sf)
+        if cause != CAUSE_NONE:
+            record_stop(xpn, xcn, xp, xc, fail_state)
+            return cause, row, t + dt
+        for i in range(nxp):
+            xp[i] = xpn[i]
+        for i in range(nxc):
+            xc[i] = xcn[i]
+    return CAUSE_NONE, row, n_steps * dt
+
+
+@kernel_part("njit(nogil=True, parallel=True)")
+def run_many(pps, xp0s, cps, xc0s, vps, rowss, curs, noises, refs, sis, sfs, ncols, accs, fails, infos, causes,
+             t_stops):
+    """:func:`run` of ``len(pps)`` runs of identical array shapes in a ``prange`` loop, metrics only.
+
+    Row ``i`` of every stacked argument is run ``i``'s array; writes ``accs``, ``fails``,
+    ``infos``, ``causes`` and ``t_stops``.
+    """
+    for i in prange(pps.shape[0]):
+        log = np.empty((0, ncols))
+        cause, _, t_stop = run(PlantBundle(pps[i], xp0s[i]), ControllerBundle(cps[i], xc0s[i], vps[i]),
+                               EnvironmentBundle(rowss[i], curs[i], noises[i]), refs[i], Settings(sis[i], sfs[i]),
+                               Outputs(log, accs[i], fails[i], infos[i]))
+        causes[i] = cause
+        t_stops[i] = t_stop
+
+
+@kernel_part("njit(nogil=True)", lanes=True)
+def run_lanes(pps, xp0s, cps, xc0s, vps, rowss, curs, noises, refs, sis, sfs, logs, accs, fails, infos, counts, causes,
+              t_stops, b0, b1):
+    """:func:`run` of LANES runs at once, one per lane of a SIMD register, for the blocks b0 .. b1 - 1.
+
+    Block ``b`` of every argument holds ``counts[b]`` runs along its last axis (length LANES; the
+    lanes beyond ``counts[b]`` are padding and never written back).  ``run__lanes`` is the lane
+    form of :func:`run` (:mod:`auvtrack.engine.lanes`): the same loop, each run's branches
+    taken in its own lane, a run that stops leaving its lane with its own cause and time.  Writes
+    ``accs``, ``fails``, ``infos`` (the runs' metrics accumulators, stop states and steps) and
+    ``causes``, ``t_stops`` (block, lane).
+    """
+    for b in range(b0, b1):
+        m = first_lanes(counts[b], LANES)  # noqa: F821  (bound in the lanes module)
+        out = Outputs(as_lanes(logs[b], LANES), as_lanes(accs[b], LANES), as_lanes(fails[b], LANES),  # noqa: F821
+                      as_lanes(infos[b], LANES))  # noqa: F821
+        cause, _, t_stop = run__lanes(PlantBundle(as_lanes(pps[b], LANES), as_lanes(xp0s[b], LANES)),  # noqa: F821
+                                      ControllerBundle(as_lanes(cps[b], LANES), as_lanes(xc0s[b], LANES),  # noqa: F821
+                                                       as_lanes(vps[b], LANES)),  # noqa: F821
+                                      EnvironmentBundle(as_lanes(rowss[b], LANES), as_lanes(curs[b], LANES),  # noqa: F821
+                                                        as_lanes(noises[b], LANES)),  # noqa: F821
+                                      as_lanes(refs[b], LANES), Settings(as_lanes(sis[b], LANES),  # noqa: F821
+                                                                          as_lanes(sfs[b], LANES)), out, m)  # noqa: F821
+        for k in range(counts[b]):
+            causes[b, k] = get_lane(cause, k)  # noqa: F821
+            t_stops[b, k] = get_lane(t_stop, k)  # noqa: F821

@@ -1,0 +1,415 @@
+"""``simulate``: the one entry point from a scenario to a :class:`Result`.
+
+``simulate`` = :func:`auvtrack.load_scenario` (validation) -> :func:`prepare` (the plant's and the
+controller's set-up: everything becomes packed float64 arrays, bundled as the engine takes them)
+-> :func:`run_prepared` (one call of the compiled kernel of the (controller, plant) pair) ->
+:class:`Result`.
+"""
+from __future__ import annotations
+
+import importlib
+
+import math
+import threading
+import time
+import warnings
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from .. import __version__
+from ..control import get as get_controller
+from ..control.contract import CONTROLLER_STATUS
+from ..environment import build_disturbance, pack_disturbances
+from ..environment.sensors import noise_table
+from ..plant import get as get_plant
+from ..vehicle.kinematics import attitude, virtual_point
+from ..vehicle.params import ELL
+from ..vehicle.presets import vehicle_arrays  # noqa: F401  (re-exported: studies use it from here)
+from ..reference import build_reference
+from ..reference.start import start_note
+from ..scenario import Scenario, load_scenario
+from ..scenario.plan import plan_run
+from ..engine import loop as engine
+from ..engine import kernels
+from ..engine.loop import ControllerBundle, EnvironmentBundle, Outputs, PlantBundle, Settings
+from .metrics import METRICS_SIZE, metrics_finalize, metrics_init
+from .result import Result
+
+BASE_CHANNELS = ("t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r",
+                 "tau_u", "tau_q", "tau_r", "xd", "yd", "zd", "ex", "ey", "ez")
+CHI_CHANNELS = ("chi_x", "chi_y", "chi_z")
+STATE_NAMES = BASE_CHANNELS[1:11]
+
+
+class SimulationInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or a stop request) ended a simulation; ``result`` holds what was computed.
+
+    Attributes
+    ----------
+    result : Result
+        The partial result, status ``"interrupted"``.
+    """
+
+    def __init__(self, result: "Result") -> None:
+        super().__init__("simulation interrupted")
+        self.result = result
+
+
+@dataclass(frozen=True)
+class SetupContext:
+    """What a controller's ``setup`` may use besides the scenario.
+
+    Attributes
+    ----------
+    vp_nom : numpy.ndarray
+        Packed nominal vehicle (:mod:`auvtrack.vehicle.params`).
+    refm0 : numpy.ndarray
+        Reference at t = 0, rows eta_d, eta_d_dot, eta_d_ddot.
+    e0 : numpy.ndarray
+        Initial virtual-point error eta1(0) - eta_d(0) (m).
+    seed : int
+        Scenario seed.
+    actuator : object
+        The scenario's ``[actuator]`` section (``tau_max``, ``rate_max``), e.g. for anti-windup.
+    dt : float
+        RK4 step (s).
+    control_rate : float
+        Controller sampling rate (Hz; 0 = continuous).
+    """
+
+    vp_nom: np.ndarray
+    refm0: np.ndarray
+    e0: np.ndarray
+    seed: int
+    actuator: Any = None
+    dt: float = 0.001
+    control_rate: float = 0.0
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A scenario turned into the bundles of the engine's kernel (:mod:`auvtrack.engine.loop`).
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The validated scenario.
+    key : KernelKey
+        The (controller law, plant) pair whose kernel runs it.
+    plant, controller, environment, settings
+        The engine's bundles.
+    ref_p : numpy.ndarray
+        Packed reference.
+    n_rows : int
+        Logged rows.
+    channels : tuple of str
+        Logged channel names, in column order.
+    notes : tuple of str
+        Set-up messages for the user.
+    resolved : dict
+        Derived values recorded in ``run.json``.
+    statuses : dict of int to str
+        Messages of the controller's status codes.
+    """
+
+    scenario: Scenario
+    key: kernels.KernelKey
+    plant: PlantBundle
+    controller: ControllerBundle
+    environment: EnvironmentBundle
+    ref_p: np.ndarray
+    settings: Settings
+    n_rows: int
+    channels: tuple[str, ...]
+    notes: tuple[str, ...]
+    resolved: dict
+    statuses: dict
+
+    # short names for the most used arrays
+    si = property(lambda self: self.settings.si, doc="Integer settings (engine SI_*).")
+    sf = property(lambda self: self.settings.sf, doc="Float settings (engine SF_*).")
+    cp = property(lambda self: self.controller.cp, doc="Packed controller parameters.")
+    vp_nom = property(lambda self: self.controller.vp, doc="Packed nominal 5-DOF vehicle.")
+    pp = property(lambda self: self.plant.pp, doc="Packed true-plant parameters.")
+    noise = property(lambda self: self.environment.noise, doc="Sensor noise table.")
+
+    @property
+    def n_steps(self) -> int:
+        """RK4 steps planned."""
+        return int(self.settings.si[engine.SI_NSTEPS])
+
+    @property
+    def n_state(self) -> int:
+        """Plant plus controller states."""
+        return self.plant.x0.size + self.controller.x0.size
+
+
+def _c(a) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def prepare(scenario: Scenario) -> Prepared:
+    """Build every array the compiled engine needs from a validated scenario.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A validated scenario (:func:`auvtrack.load_scenario`).
+
+    Returns
+    -------
+    Prepared
+        Packed float64 arrays in the engine's bundles, the logged channel names and the set-up
+        notes.
+
+    Raises
+    ------
+    ValueError
+        If the plant or the controller refuses the set-up (e.g. a start on the envelope with the
+        treatment off), naming the field, or the run plan exceeds the scenario's ``[limits]``
+        (:class:`~auvtrack.scenario.ScenarioError`, :func:`auvtrack.scenario.plan.plan_run`).
+    """
+    sc = scenario
+    plant_spec = get_plant(sc.plant.model) if hasattr(sc, "plant") else get_plant("5dof")
+    cpl = plant_spec.setup(sc)
+    vp_nom, _, _ = vehicle_arrays(sc)
+    ref = build_reference(dict(sc.reference))
+    ref_p = ref.pack()
+    eta0 = np.array(sc.initial.eta, dtype=float)
+    p0, v0, a0 = ref.evaluate(0.0)
+    refm0 = np.vstack([p0, v0, a0])
+    p1 = np.array(virtual_point(tuple(eta0), attitude(eta0[3], eta0[4]), vp_nom[ELL]))
+    ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed, actuator=sc.actuator,
+                       dt=sc.sim.dt, control_rate=sc.sim.control_rate)
+    cspec = get_controller(sc.controller.kind)
+    cc = cspec.setup(sc, ctx)
+    channels = BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names)
+    plan = plan_run(sc, len(channels))  # every size checked against [limits] before any allocation
+    tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
+    dt = sc.sim.dt
+    n_steps, log_every, ctrl_every = plan.n_steps, plan.log_every, plan.control_every
+    naux = len(cc.aux_names)
+    si = np.array([n_steps, log_every, ctrl_every, naux], dtype=np.int64)
+    t0, t1 = sc.metrics.window
+    phi_limit = getattr(sc.sim, "phi_limit", 90.0)
+    sf = np.array([dt, math.radians(sc.sim.theta_limit), sc.sim.state_limit, t0,
+                   t1 if math.isfinite(t1) else 1e300, math.radians(phi_limit)])
+    assert si.size == engine.SI_SIZE and sf.size == engine.SF_SIZE
+    sigma = (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu)
+    if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
+        raise ValueError("sensor: noise needs sim.control_rate > 0")
+    noise = noise_table(sc.seed, plan.control_samples if ctrl_every else 1, sigma)
+    key = kernels.KernelKey(cc.law or cspec.module, cpl.module or plant_spec.module,
+                            f"{cspec.name} on {plant_spec.name}")
+    return Prepared(
+        scenario=sc, key=key,
+        plant=PlantBundle(_c(cpl.pp), _c(cpl.x0)),
+        controller=ControllerBundle(_c(cc.cp), _c(cc.xc0), _c(vp_nom)),
+        environment=EnvironmentBundle(_c(tables.rows), _c(tables.current), _c(noise)),
+        ref_p=_c(ref_p), settings=Settings(si, sf),
+        n_rows=plan.log_rows,
+        channels=channels,
+        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[ELL])] if n),
+        resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
+                  "controller": cc.resolved},
+        statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
+    )
+
+
+def outputs_for(prep: Prepared, rows: int | None = None) -> Outputs:
+    """Fresh output arrays for one run of ``prep`` (``rows`` logged rows; default all, 0 = metrics only).
+
+    Parameters
+    ----------
+    prep : Prepared
+        The run.
+    rows : int, optional
+        Rows of the log.
+
+    Returns
+    -------
+    Outputs
+        Log (NaN), initialised metrics accumulator, failure state and info arrays.
+    """
+    n = prep.n_rows if rows is None else rows
+    acc = np.zeros(METRICS_SIZE)
+    metrics_init(acc)
+    return Outputs(np.full((n, len(prep.channels)), np.nan), acc, np.zeros((2, prep.n_state)),
+                   np.zeros(engine.INFO_SIZE, dtype=np.int64))
+
+
+def call_kernel(prep: Prepared, out: Outputs) -> tuple[int, int, float]:
+    """Run the kernel of ``prep`` into ``out``; return (cause, rows logged, stop time)."""
+    run = kernels.kernel(prep.key)
+    cause, rows, t_stop = run(prep.plant, prep.controller, prep.environment, prep.ref_p, prep.settings, out)
+    return int(cause), int(rows), float(t_stop)
+
+
+def _in_worker_thread(fn, stop: np.ndarray):
+    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag.
+
+    The wait is on an Event, not on ``Thread.join``: a ``join`` interrupted by Ctrl-C can report
+    the thread finished while it still runs (CPython 3.11), and the result would be lost.
+    """
+    box: dict[str, Any] = {}
+    done = threading.Event()
+
+    def target():
+        try:
+            box["value"] = fn()
+        except BaseException as exc:  # pragma: no cover - re-raised below
+            box["error"] = exc
+        finally:
+            done.set()
+
+    th = threading.Thread(target=target, name="auvtrack-run", daemon=True)
+    th.start()
+    interrupted = False
+    while not done.is_set():
+        try:
+            done.wait(0.05)
+        except KeyboardInterrupt:
+            stop[engine.INFO_STOP] = 1
+            interrupted = True
+    if "error" in box:
+        raise box["error"]
+    return box["value"], interrupted
+
+
+def run_prepared(prep: Prepared) -> Result:
+    """Run the compiled engine on prepared arrays and wrap the outcome in a :class:`Result`.
+
+    Parameters
+    ----------
+    prep : Prepared
+        The output of :func:`prepare`; it is not modified, so it can be run again.
+
+    Returns
+    -------
+    Result
+        The logged trajectory, metrics, status and (for a failed run) the failure record.
+
+    Raises
+    ------
+    SimulationInterrupted
+        On Ctrl-C during the run (within about a second); its ``result`` is the partial run.
+    """
+    from .compiling import ensure_compiled
+
+    ensure_compiled([prep])
+    out = outputs_for(prep)
+    wall = time.perf_counter()
+    if threading.current_thread() is threading.main_thread():
+        (cause, rows, t_stop), interrupted = _in_worker_thread(lambda: call_kernel(prep, out), out.info)
+    else:
+        (cause, rows, t_stop), interrupted = call_kernel(prep, out), False
+    wall = time.perf_counter() - wall
+    result = result_from(prep, out, cause, rows, t_stop, wall)
+    if interrupted or cause == engine.CAUSE_INTERRUPTED:
+        raise SimulationInterrupted(result)
+    return result
+
+
+def result_from(prep: Prepared, out: Outputs, cause: int, rows: int, t_stop: float, wall: float) -> Result:
+    """Wrap a finished kernel call in a :class:`Result` (trajectory, metrics, status, failure, meta)."""
+    failure = None if cause == engine.CAUSE_NONE else failure_record(cause, t_stop, out.fail_state, prep)
+    sc = prep.scenario
+    t0, t1 = sc.metrics.window
+    metrics = metrics_finalize(out.acc, t0, min(t1, t_stop))
+    channels = {name: out.log[:rows, j].copy() for j, name in enumerate(prep.channels)}
+    resolved = sc.to_dict()
+    resolved["resolved"] = prep.resolved
+    meta = {"version": __version__, "wall_time_s": wall, "notes": list(prep.notes),
+            "steps": int(out.info[engine.INFO_STEPS]), "steps_planned": prep.n_steps}
+    return Result(channels, resolved, status_of(cause), failure, metrics, meta)
+
+
+def status_of(cause: int) -> str:
+    """``"ok"``, ``"interrupted"`` or ``"failed"`` for a kernel's stop cause."""
+    if cause == engine.CAUSE_NONE:
+        return "ok"
+    return "interrupted" if cause == engine.CAUSE_INTERRUPTED else "failed"
+
+
+def failure_record(cause: int, t: float, fail_state: np.ndarray, prep: Prepared) -> dict[str, Any]:
+    """The ``Result.failure`` record of a stop: time, cause, detail, state and last finite state.
+
+    Parameters
+    ----------
+    cause : int
+        Kernel stop cause (``engine.CAUSE_*`` or ``CAUSE_CONTROLLER`` + status).
+    t : float
+        Stop time (s).
+    fail_state : numpy.ndarray
+        (2, n): the state at the stop and the last finite state.
+    prep : Prepared
+        The run (for channel names and status messages).
+
+    Returns
+    -------
+    dict
+        ``time``, ``cause``, ``detail``, ``state`` and, when they differ, ``last_finite_state``.
+    """
+    if cause >= engine.CAUSE_CONTROLLER:
+        name = "controller"
+        status = cause - engine.CAUSE_CONTROLLER
+        detail = prep.statuses.get(status, f"status {status}")
+    else:
+        name, detail = engine.CAUSES[cause]
+    record = {"time": float(t), "cause": name, "detail": detail, "state": _state_dict(fail_state[0], prep)}
+    if not np.array_equal(fail_state[0], fail_state[1], equal_nan=True):
+        record["last_finite_state"] = _state_dict(fail_state[1], prep)
+    return record
+
+
+def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
+    nxp = prep.plant.x0.size
+    # the 5-DOF names label the plant's pose (a 6-DOF state has roll at index 3)
+    pose = importlib.import_module(prep.key.plant).pose
+    eta, nu = pose(np.ascontiguousarray(state[:nxp], dtype=np.float64))
+    st: dict[str, Any] = {n: float(v) for n, v in zip(STATE_NAMES, (*eta, *nu))}
+    if nxp > len(STATE_NAMES):
+        st["plant_state"] = [float(x) for x in state[:nxp]]
+    if state.size > nxp:
+        st["controller_state"] = [float(x) for x in state[nxp:]]
+    return st
+
+
+def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | Mapping = (), *,
+             warn: bool = True) -> Result:
+    """Simulate a scenario and return its :class:`Result`.
+
+    Parameters
+    ----------
+    scenario : str, path, dict or Scenario
+        A TOML file, a scenario dict, or a loaded :class:`~auvtrack.scenario.Scenario`.
+    overrides : sequence of str or dict, optional
+        ``"dotted.key=value"`` overrides applied on top (see :func:`auvtrack.load_scenario`).
+    warn : bool, optional
+        Emit the controller's set-up notes (e.g. an initial envelope widening) as warnings.
+
+    Returns
+    -------
+    Result
+        Logged channels, metrics, status and failure diagnostic; a failed run keeps its
+        partial trajectory.
+
+    Raises
+    ------
+    SimulationInterrupted
+        On Ctrl-C; its ``result`` holds the partial run.
+
+    Examples
+    --------
+    >>> import auvtrack
+    >>> res = auvtrack.simulate("scenarios/paper.toml", ["sim.duration=1"])  # doctest: +SKIP
+    >>> res.to_pandas().head()  # doctest: +SKIP
+    """
+    sc = load_scenario(scenario, overrides)
+    prep = prepare(sc)
+    if warn:
+        for note in prep.notes:
+            warnings.warn(note, stacklevel=2)
+    return run_prepared(prep)

@@ -1,0 +1,48 @@
+"""auvtrack study model-gap: scenario construction and the --quick set."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from auvtrack.vehicle.kinematics import attitude, virtual_point
+from auvtrack.reference import build_reference
+from auvtrack.scenario import load_scenario
+from auvtrack.studies import model_gap as mg
+
+
+@pytest.mark.parametrize("ref", sorted(mg.REFERENCES))
+def test_start_is_beside_the_reference_at_its_speed(ref):
+    spec = mg.REFERENCES[ref]
+    eta, nu = mg.start_pose(spec)
+    p, v, _ = build_reference(spec).evaluate(0.0)
+    vp = np.array(virtual_point(tuple(eta), attitude(eta[3], eta[4]), mg.ELL))
+    assert np.linalg.norm(vp - p) == pytest.approx(0.5, abs=1e-12)   # 0.5 m to starboard
+    assert np.dot(vp - p, v) == pytest.approx(0.0, abs=1e-12)
+    assert nu[0] == pytest.approx(np.linalg.norm(v)) and nu[0] == pytest.approx(mg.SPEED, rel=0.05)
+
+
+def test_scenarios_validate_and_pick_the_truth():
+    for truth, preset in mg.TRUTHS.items():
+        sc = load_scenario(mg.scenario("ftsmc", truth, "lawnmower", True, 10.0))
+        assert sc.plant.model == ("5dof" if preset is None else "6dof")
+        assert sc.vehicle.preset == "remus100" and sc.vehicle.u0 == pytest.approx(mg.SPEED, rel=1e-6)
+        assert [d["kind"] for d in sc.disturbance] == ["current"]
+        if preset is None:
+            assert (sc.uncertainty.C, sc.uncertainty.D) == (0.0, 0.0)
+
+
+def test_quick_set_completes_or_names_its_failure(tmp_path):
+    """Every controller completes the --quick set or stops with a named cause."""
+    report = mg.run(tmp_path, quick=True)
+    rows = json.loads((tmp_path / "results.json").read_text())["rows"]
+    assert {(r["controller"], r["truth"]) for r in rows} == {(k, t) for k in mg.controllers() for t in mg.TRUTHS}
+    for r in rows:
+        assert r["status"] == "ok" or (r["status"] == "failed" and r["cause"] and r["fail_time"] is not None), r
+        if r["truth"] == "5dof":  # on its own design model every controller tracks
+            assert r["status"] == "ok" and r["max_e_late"] < 0.05, r
+    text = report.read_text()
+    assert "Failures by cause" in text and (tmp_path / "runs.csv").exists()
+    assert all(math.isfinite(r["max_theta_deg"]) for r in rows if r["max_theta_deg"] is not None)
