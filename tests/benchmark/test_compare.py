@@ -163,7 +163,7 @@ def test_quick_path_numbers_are_the_runs_numbers(quick):
 def test_simd_back_end_compiles_its_lane_kernels_before_the_timed_runs(tiny, tmp_path, monkeypatch):
     """With ``backend="simd"`` the warm-up flies a full block of lanes per signature, so no lane kernel
     compiles inside the timed runs; the numbers are those of the thread back end."""
-    from auvtrack.batch import batch as batch_mod
+    from auvtrack.batch import runner as batch_mod
 
     timed = {"on": False, "compiled_while_timed": [], "warm": set(), "timed": set()}
     real = batch_mod._LaneGroup.compile
