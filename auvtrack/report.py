@@ -263,12 +263,12 @@ def provenance() -> str:
     import numpy as np
 
     from . import __version__
-    from .engine.vecmath import BACKEND
+    from .jit.vecmath import BACKEND
 
     try:
         import numba
 
-        from .engine.jit import source_hash
+        from .jit import source_hash
 
         extra = f"Numba {numba.__version__}, vector math {BACKEND}"
         digest = f" (sources {source_hash()[:12]})"

@@ -51,7 +51,7 @@ def _demangle(symbol: str) -> str:
 def _perf_map(module, library) -> None:
     """Write /tmp/perf-<pid>.map for the functions of the lane kernel's object code.
 
-    With ``numba.config.CACHE_DIR`` set (``auvtrack.engine.jit``), Numba keeps a module's cache in
+    With ``numba.config.CACHE_DIR`` set (``auvtrack.jit``), Numba keeps a module's cache in
     ``<CACHE_DIR>/<folder>_<hash>/``: for the generated lanes module, next to ``kernels/``.
     """
     path = Path(module.__file__)

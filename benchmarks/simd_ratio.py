@@ -25,7 +25,7 @@ def ratio(overrides: dict, *, runs: int = 16, repeat: int = 7, duration: float =
     from auvtrack.batch.runner import run_batch
     from auvtrack.scenario import load_scenario, paper_scenario_path
     from auvtrack.simulation.pipeline import prepare
-    from auvtrack.simulation.metrics import METRIC_NAMES
+    from auvtrack.metrics import METRIC_NAMES
 
     preps = [prepare(load_scenario(paper_scenario_path(), {"sim.duration": duration, "seed": i,
                                                            "uncertainty.D": 0.005 * i, **overrides}))

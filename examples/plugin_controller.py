@@ -17,33 +17,37 @@ disturbance-free nominal plant e obeys e'' + kd e' + kp e = 0 (the defaults: a d
 -3 rad/s); on Section 4 the lumped disturbance chi leaves an error of about |chi| / kp.  The contract is in docs/plugins.md.
 """
 import numpy as np
-from pydantic import Field
 
 from auvtrack.control.plugin import (CompiledController, ControllerParamsBase, error_state_forces,
-                                     input_for_accel_forces, njit)
+                                     input_for_accel_forces, njit, packed_layout, tunable)
 
 AUX_NAMES = ("a_x", "a_y", "a_z")  # logged channels (the commanded e_ddot)
+GAINS = packed_layout("PDGains", kp=1, kd=1)  # the packed gains: offsets generated from the names
 
 
 class Params(ControllerParamsBase):
     """The ``params`` table of ``[controller]``."""
 
-    kp: float = Field(9.0, gt=0, description="proportional gain, 1/s^2")
-    kd: float = Field(6.0, gt=0, description="derivative gain, 1/s")
+    kp: float = tunable(9.0, 0.01, 100.0, log=True, gt=0, description="proportional gain, 1/s^2")
+    kd: float = tunable(6.0, 0.1, 50.0, log=True, gt=0, description="derivative gain, 1/s")
 
 
 @njit
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
-    """Compiled law: writes tau (N, N m) and the logged channels; returns 0 (ok)."""
-    e, ed, f, g = error_state_forces(eta, att, nu, refm, vp)
-    kp, kd = cp[0], cp[1]
+def control(t, y, xc, args, out):
+    """Compiled law: writes tau (N, N m) into out.u and the logged channels; returns 0 (ok).
+
+    y: the measured state (y.eta, y.nu, y.att); args: the reference rows (args.ref), the gains
+    (args.cp), the nominal vehicle (args.vp), ...; out: out.u, out.dxc, out.aux
+    (docs/plugins.md lists every field).
+    """
+    e, ed, f, g = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
+    kp, kd = args.cp[GAINS.kp], args.cp[GAINS.kd]
     a = (-kp * e[0] - kd * ed[0], -kp * e[1] - kd * ed[1], -kp * e[2] - kd * ed[2])
-    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, a, g)
-    aux[0], aux[1], aux[2] = a
+    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, a, g)
+    out.aux[0], out.aux[1], out.aux[2] = a
     return 0
 
 
-def setup(scenario, ctx):
+def setup(params, ctx):
     """Pack the gains for ``control``; no internal state."""
-    p = scenario.controller  # a validated Params
-    return CompiledController(cp=np.array([p.kp, p.kd]), xc0=np.zeros(0), aux_names=AUX_NAMES)
+    return CompiledController(cp=GAINS.pack(kp=params.kp, kd=params.kd), xc0=np.zeros(0), aux_names=AUX_NAMES)

@@ -5,8 +5,8 @@ lane by lane, exactly the scalar function's results.
 """
 import math
 
-from auvtrack.engine.jit import njit, njit_noalloc
-from auvtrack.engine.vecmath import atanh4, exp8, pow4, sincos4
+from auvtrack.jit import njit, njit_noalloc
+from auvtrack.jit.vecmath import atanh4, exp8, pow4, sincos4
 
 
 @njit

@@ -12,19 +12,21 @@ import sys
 
 import numpy as np
 
-from auvtrack.engine.jit import njit
+from auvtrack.jit import njit
 from auvtrack.control import fxtntsmc
-from auvtrack.control.contract import WORK_SIZE
+from auvtrack.control.contract import WORK_SIZE, LawArgs, LawOutputs, Measured
 from auvtrack.control.fxtntsmc.envelopes import baseline
 from auvtrack.vehicle.kinematics import attitude, virtual_point
-from auvtrack.vehicle.params import ELL
+from auvtrack.vehicle.params import VP
 from auvtrack.reference import eval_reference
 from auvtrack.scenario import load_scenario
 from auvtrack.simulation.pipeline import prepare
 
 N_POINTS = 3000
 NXP = 10  # Xs rows: the 5-DOF plant state, then the controller's state xc
-XC = NXP + fxtntsmc.RHO_BAR
+XC = NXP + fxtntsmc.STATE.rho_bar
+INF3 = (np.inf, np.inf, np.inf)
+NEG_INF3 = (-np.inf, -np.inf, -np.inf)
 
 
 @njit
@@ -37,7 +39,8 @@ def _evaluate(ts, Xs, atts, cp, vp, ref_p, status, taus, dXs, auxs):
         eta = (X[0], X[1], X[2], X[3], X[4])
         nu = (X[5], X[6], X[7], X[8], X[9])
         att = (atts[n, 0], atts[n, 1], atts[n, 2], atts[n, 3])
-        status[n] = fxtntsmc.control(ts[n], eta, nu, att, X[NXP:], refm, vp, cp, taus[n], dXs[n], auxs[n], work)
+        args = LawArgs(refm, ref_p, cp, vp, NEG_INF3, INF3, (0.0, 0.0, 0.0), 0.0, work)
+        status[n] = fxtntsmc.control(ts[n], Measured(eta, nu, att), X[NXP:], args, LawOutputs(taus[n], dXs[n], auxs[n]))
 
 
 @njit
@@ -65,7 +68,7 @@ def _states(sc, prep) -> tuple[np.ndarray, np.ndarray]:
         Xs[n, 5:10] = rng.normal(0.0, [0.5, 0.2, 0.2, 0.1, 0.1])
         Xs[n, XC + 3:] = prep.controller.x0[3:] + rng.normal(0.0, 0.3, nx - XC - 3)
     e = np.zeros((N_POINTS, 3))
-    _errors(ts, Xs, prep.ref_p, prep.vp_nom[ELL], e)
+    _errors(ts, Xs, prep.ref_p, prep.vp_nom[VP.ell], e)
     env = sc.envelope
     for n, t in enumerate(ts):  # rho_bar so that |e_i| / rho_i is a chosen ratio (or less)
         for i in range(3):

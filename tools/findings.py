@@ -64,7 +64,7 @@ def store(name: str, path: str | Path) -> Path:
     """
     if name not in SOURCES:
         raise KeyError(f"unknown result {name!r}; choose one of {sorted(SOURCES)}")
-    from auvtrack.engine.jit import source_hash
+    from auvtrack.jit import source_hash
 
     data = json.loads(Path(path).read_text())
     data["_provenance"] = {"command": SOURCES[name],

@@ -37,7 +37,7 @@ from ..simulation.compiling import ensure_compiled
 from ..simulation.pipeline import (Prepared, call_kernel, failure_record, outputs_for, result_from,
                               status_of)
 from ..engine.loop import Outputs
-from ..simulation.metrics import METRICS_SIZE, metrics_finalize, metrics_init
+from ..metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from ..simulation.result import Result
 
 BACKENDS = ("threads", "prange", "serial", "simd")
@@ -57,7 +57,7 @@ class RunSummary:
     failure : dict or None
         Time, cause, detail and state of a failure (as ``Result.failure``).
     metrics : dict of str to float
-        Every metric of :data:`auvtrack.simulation.metrics.METRIC_NAMES`, over the window
+        Every metric of :data:`auvtrack.metrics.METRIC_NAMES`, over the window
         actually simulated (as ``Result.metrics``).
     t_stop : float
         Simulated time at the stop (s).
@@ -80,7 +80,7 @@ class RunSummary:
 def preferred_backend(threads: str = "threads") -> str:
     """The back end for many metrics-only runs: ``"simd"`` where the vector math library is in use, else ``threads``.
 
-    Without libmvec (``auvtrack.engine.vecmath.BACKEND == "scalar"``) every vector math call of a lane
+    Without libmvec (``auvtrack.jit.vecmath.BACKEND == "scalar"``) every vector math call of a lane
     kernel becomes one scalar call per lane, and the lanes lose most of their advantage.
 
     Parameters
@@ -93,7 +93,7 @@ def preferred_backend(threads: str = "threads") -> str:
     str
         A name of :data:`BACKENDS`.
     """
-    from ..engine.vecmath import BACKEND
+    from ..jit.vecmath import BACKEND
 
     return "simd" if BACKEND == "avx2" else threads
 
@@ -195,6 +195,13 @@ def _stack(arrays: list[np.ndarray]) -> np.ndarray:
     return np.ascontiguousarray(np.stack(arrays))
 
 
+def _stacked_inputs(ps: Sequence[Prepared]) -> list[list[np.ndarray]]:
+    """Each run's input arrays in the field order of :class:`~auvtrack.engine.loop.Stacked`."""
+    return [[p.plant.pp for p in ps], [p.plant.x0 for p in ps], [p.cp for p in ps], [p.controller.x0 for p in ps],
+            [p.vp_nom for p in ps], [p.environment.rows for p in ps], [p.environment.current for p in ps],
+            [p.environment.noise for p in ps], [p.ref_p for p in ps], [p.si for p in ps], [p.sf for p in ps]]
+
+
 def _run_prange(preps: Sequence[Prepared], stop: StopSignal) -> list[RunSummary]:
     groups: dict[tuple, list[int]] = {}
     for i, p in enumerate(preps):
@@ -213,12 +220,8 @@ def _run_prange(preps: Sequence[Prepared], stop: StopSignal) -> list[RunSummary]
         stop.register(infos)
         causes = np.zeros(n, dtype=np.int64)
         t_stops = np.zeros(n)
-        runs(_stack([p.plant.pp for p in ps]), _stack([p.plant.x0 for p in ps]),
-             _stack([p.cp for p in ps]), _stack([p.controller.x0 for p in ps]), _stack([p.vp_nom for p in ps]),
-             _stack([p.environment.rows for p in ps]), _stack([p.environment.current for p in ps]),
-             _stack([p.environment.noise for p in ps]), _stack([p.ref_p for p in ps]),
-             _stack([p.si for p in ps]), _stack([p.sf for p in ps]), len(ps[0].channels),
-             accs, fails, infos, causes, t_stops)
+        runs(engine.Stacked(*(_stack(arrays) for arrays in _stacked_inputs(ps))), len(ps[0].channels),
+             engine.StackedOutputs(np.empty((n, 0, 0)), accs, fails, infos, causes, t_stops))
         for k, i in enumerate(idx):
             o = Outputs(np.empty((0, len(ps[0].channels))), accs[k], fails[k], infos[k])
             out[i] = _summary(preps[i], int(causes[k]), float(t_stops[k]), o)
@@ -264,13 +267,9 @@ class _LaneGroup:
         self.causes = np.zeros((nb, L), dtype=np.int64)
         self.t_stops = np.zeros((nb, L))
         logs = np.zeros((nb, 0, len(ps[0].channels), L))
-        self.args = (_lane_stack([p.plant.pp for p in ps], L), _lane_stack([p.plant.x0 for p in ps], L),
-                     _lane_stack([p.cp for p in ps], L), _lane_stack([p.controller.x0 for p in ps], L),
-                     _lane_stack([p.vp_nom for p in ps], L), _lane_stack([p.environment.rows for p in ps], L),
-                     _lane_stack([p.environment.current for p in ps], L),
-                     _lane_stack([p.environment.noise for p in ps], L), _lane_stack([p.ref_p for p in ps], L),
-                     _lane_stack([p.si for p in ps], L), _lane_stack([p.sf for p in ps], L), logs, self.accs,
-                     self.fails, self.infos, counts, self.causes, self.t_stops)
+        ins = engine.Stacked(*(_lane_stack(arrays, L) for arrays in _stacked_inputs(ps)))
+        outs = engine.StackedOutputs(logs, self.accs, self.fails, self.infos, self.causes, self.t_stops)
+        self.args = (ins, outs, counts)
 
     def compile(self) -> None:
         """Type and compile (or load) the lane kernel for these arguments: a call over no block."""

@@ -79,7 +79,7 @@ def _write_atomic_text(text: str, path: Path) -> None:
 
 def _manifest(spec: StudySpec) -> dict:
     from .. import __version__
-    from ..engine.jit import source_hash
+    from ..jit import source_hash
 
     return {"fingerprint": spec.fingerprint(), "name": spec.study.name, "source": spec.source,
             "n_samples": spec.n_samples, "n_chunks": spec.n_chunks, "chunk_size": spec.study.chunk_size,
@@ -389,7 +389,7 @@ def summarize(results: Path, spec: StudySpec) -> dict:
     import numpy as np
     import pyarrow.parquet as pq
 
-    from ..simulation.metrics import METRIC_NAMES
+    from ..metrics import METRIC_NAMES
 
     keys = group_keys(spec)
     table = pq.read_table(results, columns=["status", "cause", *keys, *METRIC_NAMES])

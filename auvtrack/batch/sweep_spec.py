@@ -255,7 +255,7 @@ def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
     from ..scenario import paper_scenario_path
 
     path = paper_scenario_path() if study.scenario == PAPER_SCENARIO else (folder / study.scenario)
-    from ..control.plugin import anchor_module
+    from ..user_modules import anchor_module
 
     try:
         raw = anchor_module(read_toml(path), Path(path).parent)  # a plug-in path: relative to its file

@@ -37,11 +37,11 @@ def result_schema(spec: StudySpec):
 
     Columns: sample, point, replicate, one per varied key (grid values as typed, non-scalar
     values as JSON strings; random draws as float64), seed, status, cause, detail, fail_time and
-    every metric of :data:`auvtrack.simulation.metrics.METRIC_NAMES`.
+    every metric of :data:`auvtrack.metrics.METRIC_NAMES`.
     """
     import pyarrow as pa
 
-    from ..simulation.metrics import METRIC_NAMES
+    from ..metrics import METRIC_NAMES
 
     fields = [pa.field(c, pa.int64()) for c in FIXED_COLUMNS]
     for key, vals in spec.study.grid.items():
@@ -117,7 +117,7 @@ def _table(spec: StudySpec, rows: list[dict[str, Any]]):
 
 
 def _not_run(row: dict[str, Any], status: str, cause: str, detail: str) -> dict[str, Any]:
-    from ..simulation.metrics import METRIC_NAMES
+    from ..metrics import METRIC_NAMES
 
     row.update(status=status, cause=cause, detail=detail, fail_time=math.nan)
     row.update({m: math.nan for m in METRIC_NAMES})

@@ -100,7 +100,7 @@ def chunk_path(out: Path, chunk: int) -> Path:
 def _schema():
     import pyarrow as pa
 
-    from ..simulation.metrics import METRIC_NAMES
+    from ..metrics import METRIC_NAMES
 
     ints = {"run", "seed_index", "seed", "steps"}
     floats = {"fail_time", "t_stop"}
@@ -151,11 +151,11 @@ def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1, backend: str
     -------
     pyarrow.Table
         Columns :data:`FIXED_COLUMNS` and every metric of
-        :data:`auvtrack.simulation.metrics.METRIC_NAMES`, in ``specs`` order.
+        :data:`auvtrack.metrics.METRIC_NAMES`, in ``specs`` order.
     """
     import pyarrow as pa
 
-    from ..simulation.metrics import METRIC_NAMES
+    from ..metrics import METRIC_NAMES
     from ..report import failure_cause
     from ..batch.runner import run_batch
 
@@ -249,7 +249,7 @@ def manifest_for(suite, entries: Sequence, chunk_size: int, n_runs: int, backend
     import hashlib
 
     from .. import __version__
-    from ..engine.jit import source_hash
+    from ..jit import source_hash
 
     controllers = [e.to_dict() for e in entries]
     src = source_hash()

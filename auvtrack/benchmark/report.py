@@ -239,7 +239,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
         ``report.md``.
     """
     from .. import __version__
-    from ..engine.jit import source_hash
+    from ..jit import source_hash
 
     controllers = [e.label for e in entries]
     tiers, tasks = suite.tiers, suite.tasks

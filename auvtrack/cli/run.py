@@ -68,19 +68,18 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
     """Validate SCENARIO and its --set overrides as run would (load, plan, controller set-up), without simulating.
 
-    Warns where Theorem 1's conditions fail.
+    Warns where the controller's own conditions fail (the FXTNTSMC: Theorem 1).
     """
+    from ..control import spec_for
     from ..scenario.plan import plan_run
 
     sc = load_arg(scenario, overrides)
     prep = prepare_arg(scenario, sc)
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
-    if sc.controller.kind == "fxtntsmc":
-        from ..control.fxtntsmc.theory import check_theorem1
-
-        for v in check_theorem1(sc.controller):
-            click.echo(f"warning: {v}", err=True)
+    spec = spec_for(sc.controller)
+    for v in (spec.warnings(sc.controller) if spec.warnings else []):
+        click.echo(f"warning: {v}", err=True)
     plan = plan_run(sc, len(prep.channels))
     click.echo(f"ok: {scenario} ({sc.name}: controller {sc.controller.kind}, "
                f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s: {plan.n_steps} steps, {plan.log_rows} logged rows, "
@@ -96,10 +95,11 @@ def check(scenario: str, overrides: tuple[str, ...]) -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print JSON instead of text.")
 def bounds(scenario: str, overrides: tuple[str, ...], gamma1: float, g1: float, g2: float, as_json: bool) -> None:
     """Print Theorem 1's fixed-time bounds for the FXTNTSMC gains of SCENARIO, and whether they are vacuous."""
+    from ..control import fxtntsmc
     from ..control.fxtntsmc.theory import fixed_time_bounds
 
     sc = load_arg(scenario, overrides)
-    if sc.controller.kind != "fxtntsmc":
+    if not isinstance(sc.controller, fxtntsmc.Params):  # Theorem 1 is the FXTNTSMC's
         raise BadInput(f"controller.kind: bounds exist for 'fxtntsmc' only (got {sc.controller.kind!r})")
     b = fixed_time_bounds(sc.controller, gamma1=gamma1, g1=g1, g2=g2, horizon=sc.sim.duration)
     click.echo(json.dumps(b.to_dict(), indent=2) if as_json else b.report())

@@ -1,11 +1,12 @@
 """Controllers: registry, shared tracking kinematics and the compiled laws.
 
-Registering a built-in controller is one line: its module in :data:`BUILTIN`.  ``plugin`` is
-registered after them: it is the loader of controllers from outside the package (kind ``"plugin"``).
+Registering a built-in controller is one line: its module in :data:`BUILTIN` (checked against
+:mod:`auvtrack.control.contract`).  ``plugin`` is registered after them: it is the loader of
+controllers from outside the package (kind ``"plugin"``).
 """
 from . import backstepping, ftsmc, fxtntsmc, open_loop, open_loop_actuators, pid, plugin, ppc, sta
-from .gain_presets import FTSMCParams, FXTNTSMCParams, OpenLoopParams
-from .registry import CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, get, register
+from .registry import (CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, SetupContext,
+                       check_controller, get, register)
 
 BUILTIN = (
     fxtntsmc,
@@ -20,8 +21,27 @@ BUILTIN = (
 BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
 """Kinds of the built-in controllers (``plugin``, the loader of outside controllers, is not one)."""
 for _module in BUILTIN:
-    register(ControllerSpec.from_module(_module))
-register(ControllerSpec.from_module(plugin))
+    register(_module)
+register(ControllerSpec(plugin.NAME, plugin.__name__, plugin.Params, plugin.setup,
+                        "a controller module from outside the package (controller.module)"))
 
-__all__ = ["BUILTIN", "BUILTIN_NAMES", "CONTROLLERS", "CompiledController", "ControllerParams", "ControllerSpec", "get",
-           "register", "FTSMCParams", "FXTNTSMCParams", "OpenLoopParams"]
+__all__ = ["BUILTIN", "BUILTIN_NAMES", "CONTROLLERS", "CompiledController", "ControllerParams", "ControllerSpec",
+           "SetupContext", "check_controller", "get", "register", "spec_for"]
+
+
+def spec_for(section) -> ControllerSpec:
+    """The record of the controller a validated ``[controller]`` section selects (a plug-in's own for ``"plugin"``).
+
+    Parameters
+    ----------
+    section : pydantic model
+        The scenario's ``[controller]``.
+
+    Returns
+    -------
+    ControllerSpec
+        The registered record, or the plug-in's checked record.
+    """
+    if section.kind == plugin.NAME:
+        return plugin.spec_of(section)
+    return get(section.kind)

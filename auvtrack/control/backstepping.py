@@ -31,14 +31,15 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
+from ..packing import packed_layout
 from .gain_checks import require
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "backstepping"
 AUX_NAMES = ("z2_x", "z2_y", "z2_z", "b_hat_x", "b_hat_y", "b_hat_z")
-C1, C2, GAMMA, SIGMA = 0, 1, 2, 3
+GAINS = packed_layout("BacksteppingGains", c1=1, c2=1, gamma=1, sigma=1)
 
 
 class Params(ControllerParams):
@@ -60,16 +61,18 @@ def axis(e, ed, bh, c1, c2, gam, sig):
 
 
 @njit_noalloc(inline="always")
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control(t, y, xc, args, out):
     """Compiled backstepping law, eq. (B1)-(B3) (tau in N, N m); returns 0."""
-    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
-    c1, c2, gam, sig = cp[C1], cp[C2], cp[GAMMA], cp[SIGMA]
+    e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
+    cp = args.cp
+    c1, c2, gam, sig = cp[GAINS.c1], cp[GAINS.c2], cp[GAINS.gamma], cp[GAINS.sigma]
     z0, a0, d0 = axis(e[0], ed[0], xc[0], c1, c2, gam, sig)
     z1, a1, d1 = axis(e[1], ed[1], xc[1], c1, c2, gam, sig)
     z2, a2, d2 = axis(e[2], ed[2], xc[2], c1, c2, gam, sig)
-    dxc[0], dxc[1], dxc[2] = d0, d1, d2
+    out.dxc[0], out.dxc[1], out.dxc[2] = d0, d1, d2
+    aux = out.aux
     aux[0], aux[1], aux[2], aux[3], aux[4], aux[5] = z0, z1, z2, xc[0], xc[1], xc[2]
-    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, (a0, a1, a2), gf)
+    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
     return 0
 
 
@@ -90,10 +93,10 @@ def check(p: Params) -> None:
             p.sigma)
 
 
-def setup(scenario, ctx) -> CompiledController:
+def setup(params: Params, ctx) -> CompiledController:
     """Pack the gains; b_hat(0) = 0 (adaptation off: gamma = sigma = 0 and b_hat stays 0)."""
-    p: Params = scenario.controller
+    p = params
     check(p)
     gam = p.gamma if p.adaptive else 0.0
-    cp = np.array([p.c1, p.c2, gam, p.sigma], dtype=np.float64)
+    cp = GAINS.pack(c1=p.c1, c2=p.c2, gamma=gam, sigma=p.sigma)
     return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES)

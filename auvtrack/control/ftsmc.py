@@ -20,12 +20,14 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
+from ..packing import packed_layout
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
 
 NAME = "ftsmc"
-AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z")  # formerly s_* (auvtrack/simulation/channels.py)
+AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z")
+GAINS = packed_layout("FTSMCGains", beta=1, gamma=1, k1=1, k2=1)
 
 
 class Params(ControllerParams):
@@ -56,19 +58,21 @@ def reaching(e, ed, beta, gam, k1, k2):
 
 
 @njit_noalloc(inline="always")  # one function with the engine for LLVM (docs/architecture.md)
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control(t, y, xc, args, out):
     """Compiled FTSMC law; returns status 0 (it has no failure modes of its own)."""
-    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
-    s0, a0 = reaching(e[0], ed[0], cp[0], cp[1], cp[2], cp[3])
-    s1, a1 = reaching(e[1], ed[1], cp[0], cp[1], cp[2], cp[3])
-    s2, a2 = reaching(e[2], ed[2], cp[0], cp[1], cp[2], cp[3])
-    aux[0], aux[1], aux[2] = s0, s1, s2
-    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, (a0, a1, a2), gf)
+    e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
+    cp = args.cp
+    beta, gam, k1, k2 = cp[GAINS.beta], cp[GAINS.gamma], cp[GAINS.k1], cp[GAINS.k2]
+    s0, a0 = reaching(e[0], ed[0], beta, gam, k1, k2)
+    s1, a1 = reaching(e[1], ed[1], beta, gam, k1, k2)
+    s2, a2 = reaching(e[2], ed[2], beta, gam, k1, k2)
+    out.aux[0], out.aux[1], out.aux[2] = s0, s1, s2
+    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
     return 0
 
 
-def setup(scenario, ctx) -> CompiledController:
-    """Pack the FTSMC gains of ``scenario.controller``."""
-    p: Params = scenario.controller
-    cp = np.array([p.beta, p.gamma, p.k1, p.k2], dtype=np.float64)
+def setup(params: Params, ctx) -> CompiledController:
+    """Pack the FTSMC gains."""
+    p = params
+    cp = GAINS.pack(beta=p.beta, gamma=p.gamma, k1=p.k1, k2=p.k2)
     return CompiledController(cp=cp, xc0=np.zeros(0), aux_names=AUX_NAMES)

@@ -1,8 +1,8 @@
-"""Gain presets (controller gains stored as data) and the parameter models of the built-in controllers.
+"""Gain presets: controller gains stored as data, each with its provenance.
 
-Each controller's ``Params`` model is defined in its own module; the names below are aliases kept
-for existing imports.  Field names are the stable scenario keys; ranges are the *basic*
-admissibility ranges (Theorem 1's stricter conditions: :mod:`auvtrack.control.fxtntsmc.theory`).
+A preset is ``auvtrack/data/gains/<name>.toml``: the controller ``kind``, a ``[gains]`` table of
+its ``[controller]`` keys, a description and how the gains were produced.  ``controller.preset``
+in a scenario expands a preset into those keys.
 """
 from __future__ import annotations
 
@@ -10,12 +10,7 @@ import tomllib
 from dataclasses import dataclass
 from importlib import resources
 
-from .ftsmc import Params as FTSMCParams
-from .fxtntsmc import Params as FXTNTSMCParams
-from .open_loop import Params as OpenLoopParams
-
-__all__ = ["FTSMCParams", "FXTNTSMCParams", "OpenLoopParams", "GainPreset", "available_gain_presets",
-           "get_gain_preset"]
+__all__ = ["GainPreset", "available_gain_presets", "get_gain_preset"]
 
 # --------------------------------------------------------------------------- gain presets
 

@@ -2,7 +2,7 @@
 
 Useful to exercise the plant alone (manoeuvring checks) and, being smooth, to verify the
 integrator's order of convergence on the real closed-loop engine.
-Packed ``cp`` = [tau0 (3), amplitude (3), frequency (3)]; no internal state, no aux channels.
+Packed :data:`GAINS`; no internal state, no aux channels.
 """
 from __future__ import annotations
 
@@ -12,11 +12,14 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..engine.jit import njit
+from ..jit import njit
+from ..packing import packed_layout
 from .registry import CompiledController, ControllerParams
 
 NAME = "open_loop"
 AUX_NAMES: tuple[str, ...] = ()
+TRACKS = False
+GAINS = packed_layout("OpenLoopInput", tau0=3, amplitude=3, frequency=3)
 
 
 class Params(ControllerParams):
@@ -30,15 +33,16 @@ class Params(ControllerParams):
 
 
 @njit
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control(t, y, xc, args, out):
     """Compiled open-loop input."""
+    cp = args.cp
     for i in range(3):
-        tau[i] = cp[i] + cp[3 + i] * math.sin(2.0 * math.pi * cp[6 + i] * t)
+        out.u[i] = cp[GAINS.tau0 + i] + cp[GAINS.amplitude + i] * math.sin(2.0 * math.pi * cp[GAINS.frequency + i] * t)
     return 0
 
 
-def setup(scenario, ctx) -> CompiledController:
-    """Pack the open-loop input of ``scenario.controller``."""
-    p = scenario.controller
-    cp = np.array([*p.tau0, *p.amplitude, *p.frequency], dtype=np.float64)
+def setup(params: Params, ctx) -> CompiledController:
+    """Pack the open-loop input."""
+    p = params
+    cp = GAINS.pack(tau0=p.tau0, amplitude=p.amplitude, frequency=p.frequency)
     return CompiledController(cp=cp, xc0=np.zeros(0))

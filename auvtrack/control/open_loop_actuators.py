@@ -3,7 +3,7 @@
 The controller commands the actuators directly (the plant's allocation passes them through):
 propeller speed ``rpm`` (rpm), stern-plane angle ``delta_s`` and rudder angle ``delta_r`` (rad,
 in the plant preset's sign convention, docs/vehicles.md), the rudder put over at ``t_execute``;
-with ``rpm_trim`` the propeller holds the initial surge speed (:func:`auvtrack.plant.sixdof.truth.trim_rpm`).
+with ``rpm_trim`` the propeller keeps the speed the plant starts with (trimmed to the initial surge speed).
 
 Zig-zag (``zigzag_psi > 0``, the ITTC Z-manoeuvre): the rudder is ``s * delta_r`` with a relay
 state s = +-1 reversed each time the heading change psi - psi0 reaches +-zigzag_psi against the
@@ -11,8 +11,8 @@ current turn.  The relay is written as one internal state with first-order switc
 ``ds/dt = (s_target - s) / T_RELAY`` (T_RELAY = 0.02 s, fast against the 0.1 s fin servo), so the
 engine integrates it like any other state (no hidden memory, same in both control modes).
 
-Packed ``cp`` = [rpm, delta_s, delta_r, zigzag_psi, psi0, d, t_execute] with d the sign of the
-heading change that +delta_r produces on this plant; ``xc`` = [s]; logged ``zigzag_s``.
+Packed :data:`GAINS` (``turn``: the sign of the heading change that +delta_r produces on this
+plant); ``xc`` = [s]; logged ``zigzag_s``.
 """
 from __future__ import annotations
 
@@ -22,13 +22,17 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..engine.jit import njit
+from ..jit import njit
+from ..packing import packed_layout
 from .registry import CompiledController, ControllerParams
 
 NAME = "open_loop_actuators"
 AUX_NAMES: tuple[str, ...] = ("zigzag_s",)
 T_RELAY = 0.02  # s
-C_RPM, C_DS, C_DR, C_ZIG, C_PSI0, C_TURN, C_TEXE = range(7)
+COMMANDS = "actuators"
+TRACKS = False
+GAINS = packed_layout("OpenLoopActuators", rpm=1, delta_s=1, delta_r=1, zigzag_psi=1, psi0=1, turn=1,
+                      t_execute=1)
 
 
 class Params(ControllerParams):
@@ -48,54 +52,60 @@ class Params(ControllerParams):
 
 
 @njit
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
-    """Compiled actuator commands: tau = (rpm, delta_s, delta_r) for the plant's pass-through allocation."""
+def control(t, y, xc, args, out):
+    """Compiled actuator commands: u = (rpm, delta_s, delta_r) for the plant's pass-through allocation."""
+    cp, dxc = args.cp, out.dxc
     s = xc[0]
     dxc[0] = 0.0
     rudder = 0.0
-    if t >= cp[C_TEXE]:
-        if cp[C_ZIG] > 0.0:
-            turned = cp[C_TURN] * (eta[4] - cp[C_PSI0])  # heading change in the direction +delta_r turns
+    if t >= cp[GAINS.t_execute]:
+        if cp[GAINS.zigzag_psi] > 0.0:
+            turned = cp[GAINS.turn] * (y.eta[4] - cp[GAINS.psi0])  # heading change in the direction +delta_r turns
             target = 1.0 if s >= 0.0 else -1.0
-            if turned >= cp[C_ZIG]:
+            if turned >= cp[GAINS.zigzag_psi]:
                 target = -1.0
-            elif turned <= -cp[C_ZIG]:
+            elif turned <= -cp[GAINS.zigzag_psi]:
                 target = 1.0
             dxc[0] = (target - s) / T_RELAY
-            rudder = s * cp[C_DR]
+            rudder = s * cp[GAINS.delta_r]
         else:
-            rudder = cp[C_DR]
-    tau[0] = cp[C_RPM]
-    tau[1] = cp[C_DS]
-    tau[2] = rudder
-    aux[0] = s
+            rudder = cp[GAINS.delta_r]
+    out.u[0] = cp[GAINS.rpm]
+    out.u[1] = cp[GAINS.delta_s]
+    out.u[2] = rudder
+    out.aux[0] = s
     return 0
 
 
-def rudder_turn_sign(preset: str) -> float:
-    """Sign of the yaw moment (hence of the heading change) a positive rudder angle gives on ``preset``."""
-    from ..plant.sixdof.truth import MODELS, pack_truth
-    model, pp = MODELS[preset], pack_truth(preset)
-    if preset == "remus100_prestero":
-        tr = model.produced(1.0, 0.1, 0.0, 0.0, pp)[2]
-    else:
-        tr = model.produced(1.0, 0.0, 0.0, 0.1, 0.0, 0.0, pp)[2]
+def rudder_turn_sign(plant) -> float:
+    """Sign of the yaw moment (hence of the heading change) a positive rudder angle gives on ``plant``.
+
+    Parameters
+    ----------
+    plant : auvtrack.control.registry.PlantView
+        The plant flown: its ``applied`` tau with the rudder at +0.1 rad at 1 m/s.
+
+    Returns
+    -------
+    float
+        +1 or -1.
+    """
+    tr = plant.applied(u=1.0, delta_r=0.1)[2]
     return 1.0 if tr > 0 else -1.0
 
 
-def setup(scenario, ctx) -> CompiledController:
-    """Pack the commands of ``scenario.controller`` (the schema checks them against the plant's limits)."""
-    p = scenario.controller
-    if scenario.plant.model != "6dof":
-        raise ValueError("controller.kind: open_loop_actuators commands fins and propeller; it needs "
-                         f"plant.model = \"6dof\" (got {scenario.plant.model!r})")
-    d = rudder_turn_sign(scenario.plant.preset) * (1.0 if p.delta_r >= 0 else -1.0)
-    rpm = p.rpm
-    if p.rpm_trim:
-        from ..plant.sixdof.truth import pack_truth, trim_rpm
-        rpm = trim_rpm(scenario.plant.preset, pack_truth(scenario.plant.preset, scenario.plant.actuator_overrides()),
-                       scenario.initial.nu[0])
-    cp = np.array([rpm, p.delta_s, p.delta_r, p.zigzag_psi, scenario.initial.eta[4], d, p.t_execute],
-                  dtype=np.float64)
+def setup(params: Params, ctx) -> CompiledController:
+    """Pack the commands, checked against the plant's actuator limits (``ctx.plant``)."""
+    p = params
+    lo, hi, _ = ctx.plant.feedback()  # the actuators' limits: (rpm, stern plane, rudder)
+    for k, i, key in (("rpm", 0, "n_max"), ("delta_s", 1, "delta_max"), ("delta_r", 2, "delta_max")):
+        v = getattr(p, k)
+        if not lo[i] <= v <= hi[i]:
+            raise ValueError(f"controller.{k}: beyond the actuator limit plant.{key} = {hi[i]:.6g} "
+                             f"(got {v:.6g})")
+    d = rudder_turn_sign(ctx.plant) * (1.0 if p.delta_r >= 0 else -1.0)
+    rpm = ctx.plant.initial("n") if p.rpm_trim else p.rpm  # the plant starts with its propeller trimmed
+    cp = GAINS.pack(rpm=rpm, delta_s=p.delta_s, delta_r=p.delta_r, zigzag_psi=p.zigzag_psi, psi0=ctx.eta0[4],
+                    turn=d, t_execute=p.t_execute)
     return CompiledController(cp=cp, xc0=np.ones(1), aux_names=AUX_NAMES,
                               resolved={"rudder_turn_sign": d, "rpm": rpm})

@@ -18,8 +18,8 @@ acceleration feed-forward, Spong, Hutchinson & Vidyasagar (2006), *Robot Modelin
 ch. 8 (inverse dynamics); back-calculation anti-windup with tracking gain 1/T_t, Astrom &
 Hagglund (2006), *Advanced PID Control*, ch. 3 (integrator windup).
 
-Packed ``cp`` = [kp, ki, kd, kaw / ki (0 if ki = 0), tau_max (3)]; internal state xc = I (3,
-m s); logged aux: I_x, I_y, I_z.
+Packed gains :data:`GAINS` (``kaw_ki`` = kaw / ki, 0 if ki = 0); internal state xc = I (3, m s);
+logged aux: I_x, I_y, I_z.
 """
 from __future__ import annotations
 
@@ -27,16 +27,17 @@ import numpy as np
 from pydantic import Field
 from typing import Literal
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
+from ..packing import packed_layout
 from ..vehicle.kinematics import j3
-from ..vehicle.params import ELL, M0
+from ..vehicle.params import VP
 from .gain_checks import require
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, mat_vec
 
 NAME = "pid"
 AUX_NAMES = ("I_x", "I_y", "I_z")
-KP, KI, KD, KAW_KI, TAU_MAX = 0, 1, 2, 3, 4
+GAINS = packed_layout("PIDGains", kp=1, ki=1, kd=1, kaw_ki=1, tau_max=3)
 
 
 class Params(ControllerParams):
@@ -58,26 +59,27 @@ def _clip(x, m):
 
 
 @njit_noalloc(inline="always")
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control(t, y, xc, args, out):
     """Compiled PID law, eq. (P1)-(P2) (tau in N, N m); returns 0 (no failure modes of its own)."""
-    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
-    kp, ki, kd = cp[KP], cp[KI], cp[KD]
+    att, vp, cp, tau, dxc = y.att, args.vp, args.cp, out.u, out.dxc
+    e, ed, f, gf = error_state_forces(y.eta, att, y.nu, args.ref, vp)
+    kp, ki, kd = cp[GAINS.kp], cp[GAINS.ki], cp[GAINS.kd]
     a = (-kp * e[0] - kd * ed[0] - ki * xc[0],
          -kp * e[1] - kd * ed[1] - ki * xc[1],
          -kp * e[2] - kd * ed[2] - ki * xc[2])
     t0, t1, t2 = input_for_accel_forces(att, vp, f, a, gf)
     tau[0], tau[1], tau[2] = t0, t1, t2
     # e_ddot removed by the saturation on the nominal model: J3 M_bar^-1 (sat(tau) - tau)
-    dv = ((_clip(t0, cp[TAU_MAX]) - t0) / vp[M0],
-          (_clip(t1, cp[TAU_MAX + 1]) - t1) / vp[M0 + 3],
-          (_clip(t2, cp[TAU_MAX + 2]) - t2) / vp[M0 + 4])
-    da = mat_vec(j3(att, vp[ELL]), dv)
-    g = cp[KAW_KI]
+    dv = ((_clip(t0, cp[GAINS.tau_max]) - t0) / vp[VP.m],
+          (_clip(t1, cp[GAINS.tau_max + 1]) - t1) / vp[VP.m + 3],
+          (_clip(t2, cp[GAINS.tau_max + 2]) - t2) / vp[VP.m + 4])
+    da = mat_vec(j3(att, vp[VP.ell]), dv)
+    g = cp[GAINS.kaw_ki]
     on = 1.0 if ki > 0.0 else 0.0  # a PD keeps its (unused) integrator at rest
     dxc[0] = on * (e[0] - g * da[0])
     dxc[1] = on * (e[1] - g * da[1])
     dxc[2] = on * (e[2] - g * da[2])
-    aux[0], aux[1], aux[2] = xc[0], xc[1], xc[2]
+    out.aux[0], out.aux[1], out.aux[2] = xc[0], xc[1], xc[2]
     return 0
 
 
@@ -99,12 +101,12 @@ def check(p: Params) -> None:
             p.ki)
 
 
-def setup(scenario, ctx) -> CompiledController:
+def setup(params: Params, ctx) -> CompiledController:
     """Check eq. (P3)'s stability condition and pack gains and actuator limits; I(0) = 0."""
-    p: Params = scenario.controller
+    p = params
     check(p)
     tau_max = np.asarray(ctx.actuator.tau_max, dtype=np.float64)
-    cp = np.array([p.kp, p.ki, p.kd, p.kaw / p.ki if p.ki > 0 else 0.0, *tau_max], dtype=np.float64)
+    cp = GAINS.pack(kp=p.kp, ki=p.ki, kd=p.kd, kaw_ki=p.kaw / p.ki if p.ki > 0 else 0.0, tau_max=tau_max)
     notes = ()
     if p.ki > 0 and p.kaw == 0 and bool(np.any(np.isfinite(tau_max))):
         notes = ("pid: controller.kaw = 0 with a finite actuator.tau_max: the integrator may wind up",)

@@ -37,15 +37,15 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
+from ..packing import packed_layout
 from .gain_checks import fmt, require
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "ppc"
 AUX_NAMES = ("rho_x", "rho_y", "rho_z", "eps_x", "eps_y", "eps_z")
-STATUS = {1: "envelope violated: |e_i| >= rho_i (the error transformation is undefined)"}
-KP, KD, DECAY, RHO0, RHOINF = 0, 1, 2, 3, 6
+GAINS = packed_layout("PPCGains", kp=1, kd=1, l=1, rho0=3, rho_inf=3)
 AXES = ("x", "y", "z")
 Pos = Annotated[float, Field(gt=0)]
 
@@ -97,14 +97,15 @@ def axis(e, ed, rho, rhod, rhodd, kp, kd):
 
 
 @njit_noalloc(inline="always")
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control(t, y, xc, args, out):
     """Compiled PPC law, eq. (R1)-(R4) (tau in N, N m); status 1 if an error reaches its envelope."""
-    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
-    kp, kd, l = cp[KP], cp[KD], cp[DECAY]
+    e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
+    cp, aux = args.cp, out.aux
+    kp, kd, l = cp[GAINS.kp], cp[GAINS.kd], cp[GAINS.l]
     x = math.exp(-l * t)  # shared by the three axes
-    r0 = envelope_x(x, cp[RHO0], cp[RHOINF], l)
-    r1 = envelope_x(x, cp[RHO0 + 1], cp[RHOINF + 1], l)
-    r2 = envelope_x(x, cp[RHO0 + 2], cp[RHOINF + 2], l)
+    r0 = envelope_x(x, cp[GAINS.rho0], cp[GAINS.rho_inf], l)
+    r1 = envelope_x(x, cp[GAINS.rho0 + 1], cp[GAINS.rho_inf + 1], l)
+    r2 = envelope_x(x, cp[GAINS.rho0 + 2], cp[GAINS.rho_inf + 2], l)
     aux[0], aux[1], aux[2] = r0[0], r1[0], r2[0]
     st0, eps0, a0 = axis(e[0], ed[0], r0[0], r0[1], r0[2], kp, kd)
     st1, eps1, a1 = axis(e[1], ed[1], r1[0], r1[1], r1[2], kp, kd)
@@ -112,7 +113,7 @@ def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
     if st0 + st1 + st2 != 0:
         return 1
     aux[3], aux[4], aux[5] = eps0, eps1, eps2
-    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, (a0, a1, a2), gf)
+    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
     return 0
 
 
@@ -139,10 +140,10 @@ def check(p: Params, e0) -> None:
                 f">= rho0_{a}); enlarge rho0 (a rigid PPC cannot widen)", list(p.rho0))
 
 
-def setup(scenario, ctx) -> CompiledController:
+def setup(params: Params, ctx) -> CompiledController:
     """Check the envelope against the start ``ctx.e0`` and pack gains and envelope."""
-    p: Params = scenario.controller
+    p = params
     check(p, ctx.e0)
-    cp = np.array([p.kp, p.kd, p.l, *p.rho0, *p.rho_inf], dtype=np.float64)
+    cp = GAINS.pack(kp=p.kp, kd=p.kd, l=p.l, rho0=p.rho0, rho_inf=p.rho_inf)
     xi0 = [float(ctx.e0[i] / p.rho0[i]) for i in range(3)]
     return CompiledController(cp=cp, xc0=np.zeros(0), aux_names=AUX_NAMES, resolved={"xi0": xi0})

@@ -37,14 +37,15 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
+from ..packing import packed_layout
 from .gain_checks import require
 from .registry import CompiledController, ControllerParams
 from .tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "sta"
 AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z", "integral_x", "integral_y", "integral_z")  # s and v
-LAM, K1, K2 = 0, 1, 2
+GAINS = packed_layout("STAGains", lam=1, k1=1, k2=1)
 
 
 class Params(ControllerParams):
@@ -72,16 +73,18 @@ def axis(e, ed, v, lam, k1, k2):
 
 
 @njit_noalloc(inline="always")
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control(t, y, xc, args, out):
     """Compiled super-twisting law, eq. (S1)-(S3) (tau in N, N m); returns 0."""
-    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
-    lam, k1, k2 = cp[LAM], cp[K1], cp[K2]
+    e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
+    cp = args.cp
+    lam, k1, k2 = cp[GAINS.lam], cp[GAINS.k1], cp[GAINS.k2]
     s0, a0, d0 = axis(e[0], ed[0], xc[0], lam, k1, k2)
     s1, a1, d1 = axis(e[1], ed[1], xc[1], lam, k1, k2)
     s2, a2, d2 = axis(e[2], ed[2], xc[2], lam, k1, k2)
-    dxc[0], dxc[1], dxc[2] = d0, d1, d2
+    out.dxc[0], out.dxc[1], out.dxc[2] = d0, d1, d2
+    aux = out.aux
     aux[0], aux[1], aux[2], aux[3], aux[4], aux[5] = s0, s1, s2, xc[0], xc[1], xc[2]
-    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, (a0, a1, a2), gf)
+    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
     return 0
 
 
@@ -119,11 +122,11 @@ def check(p: Params) -> None:
                 "(Moreno-Osorio Lyapunov condition, eq. S5)", p.k2)
 
 
-def setup(scenario, ctx) -> CompiledController:
+def setup(params: Params, ctx) -> CompiledController:
     """Check the gain condition and pack the gains; v(0) = 0."""
-    p: Params = scenario.controller
+    p = params
     check(p)
-    cp = np.array([p.lam, p.k1, p.k2], dtype=np.float64)
+    cp = GAINS.pack(lam=p.lam, k1=p.k1, k2=p.k2)
     return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES,
                               resolved={"levant_k1_min": levant_k1_min(p.k2, p.L) if p.k2 > p.L else None,
                                         "moreno_osorio_k2_min": moreno_osorio_k2_min(p.k1, p.L)})

@@ -14,10 +14,10 @@ All functions are compiled and work on tuples (see :mod:`auvtrack.vehicle.kinema
 """
 from __future__ import annotations
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
 from ..vehicle.dynamics import generalized_forces
 from ..vehicle.kinematics import j3, j3_dot, j3_inv, j4, j4_dot, virtual_point
-from ..vehicle.params import ELL, M0
+from ..vehicle.params import VP
 
 
 @njit
@@ -45,7 +45,7 @@ def error_state_forces(eta, att, nu, refm, vp):
     The forces are reused by :func:`input_for_accel_forces` at the same state (one evaluation
     per controller call).
     """
-    ell = vp[ELL]
+    ell = vp[VP.ell]
     u, v, w, q, r = nu[0], nu[1], nu[2], nu[3], nu[4]
     v1 = (u, q, r)
     p1 = virtual_point(eta, att, ell)
@@ -55,7 +55,7 @@ def error_state_forces(eta, att, nu, refm, vp):
     ed = (jv[0] + d4[0] - refm[1, 0], jv[1] + d4[1] - refm[1, 1], jv[2] + d4[2] - refm[1, 2])
     # nominal sway/heave accelerations for J4_dot (ERRATA 4)
     g = generalized_forces(att, nu, vp)
-    v_dot, w_dot = -g[1] / vp[M0 + 1], -g[2] / vp[M0 + 2]
+    v_dot, w_dot = -g[1] / vp[VP.m + 1], -g[2] / vp[VP.m + 2]
     th_dot, ps_dot = q, r / att[0]
     jd = mat_vec(j3_dot(att, th_dot, ps_dot, ell), v1)
     d4d = j4_dot(att, v, w, th_dot, ps_dot, v_dot, w_dot)
@@ -75,8 +75,8 @@ def input_for_accel(att, nu, vp, f, acc):
 @njit_noalloc
 def input_for_accel_forces(att, vp, f, acc, g):
     """:func:`input_for_accel` with g = generalized_forces(att, nu, vp) already evaluated."""
-    a = mat_vec(j3_inv(att, vp[ELL]), (acc[0] - f[0], acc[1] - f[1], acc[2] - f[2]))
-    return vp[M0] * a[0] + g[0], vp[M0 + 3] * a[1] + g[3], vp[M0 + 4] * a[2] + g[4]
+    a = mat_vec(j3_inv(att, vp[VP.ell]), (acc[0] - f[0], acc[1] - f[1], acc[2] - f[2]))
+    return vp[VP.m] * a[0] + g[0], vp[VP.m + 3] * a[1] + g[3], vp[VP.m + 4] * a[2] + g[4]
 
 
 @njit

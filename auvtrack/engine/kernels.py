@@ -9,7 +9,7 @@ small module for the pair into the kernel cache folder (a verbatim copy of the e
 * only the pairs a run needs are ever compiled (a new controller or plant costs nothing until
   used), and each pair gets its own specialised loop: the law is inlined, with no run-time
   dispatch;
-* the folder is named by a hash of every package source (:func:`auvtrack.engine.jit.cache_dir`); a
+* the folder is named by a hash of every package source (:func:`auvtrack.jit.cache_dir`); a
   plug-in's kernel is also named by a hash of the plug-in file, so editing either selects fresh
   kernels (a plug-in's own imports of other files are not hashed: see ``docs/plugins.md``);
 * :func:`warmup` compiles several pairs in parallel, one process each, and reports progress; a
@@ -20,13 +20,11 @@ or the path of a ``.py`` file (a plug-in), whose module defines ``control``.
 """
 from __future__ import annotations
 
-import hashlib
 import importlib
 import importlib.util
 import inspect
 import json
 import os
-import re
 import subprocess
 import sys
 import tempfile
@@ -39,10 +37,12 @@ from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
-from . import jit as _jit
+from .. import jit as _jit
+from ..user_modules import file_digest
+from ..user_modules import identifier as _ident
 from . import loop as engine
 
-__all__ = ["KernelKey", "kernel", "is_compiled", "warmup", "law_module", "kernel_source",
+__all__ = ["KernelKey", "kernel", "is_compiled", "warmup", "kernel_source",
            "compile_estimate"]
 
 COMPILE_ESTIMATE_S = 20.0  # shown before the first compile of a kernel when nothing was measured yet
@@ -50,14 +50,14 @@ COMPILE_ESTIMATE_S = 20.0  # shown before the first compile of a kernel when not
 
 @dataclass(frozen=True)
 class KernelKey:
-    """One kernel: a controller law (module name or ``.py`` path) and a plant module name.
+    """One kernel: a controller law and a plant, each a module name or a ``.py`` path.
 
     Attributes
     ----------
     law : str
-        ``"auvtrack.control.fxtntsmc"`` or ``"/abs/path/my_controller.py"``.
+        ``"auvtrack.control.fxtntsmc"``, ``"my_package.my_law"`` or ``"/abs/path/my_controller.py"``.
     plant : str
-        ``"auvtrack.plant.five_dof"``.
+        ``"auvtrack.plant.five_dof"`` or a plug-in plant's module name or ``.py`` path.
     label : str
         Human name for messages, e.g. ``"fxtntsmc on 5dof"``.
     """
@@ -74,63 +74,24 @@ class KernelKey:
     @property
     def name(self) -> str:
         """Identifier of the generated module (also its file name)."""
-        if self.is_file:
-            path = Path(self.law).resolve()
-            digest = hashlib.sha256(path.read_bytes()).hexdigest()[:12]
-            law = f"plugin_{_ident(path.stem)}_{digest}"
-        elif self.law.startswith("auvtrack."):
-            law = _ident(self.law.rsplit(".", 1)[-1])
-        else:  # a plug-in given by module name: its full name and the hash of its file
-            spec = importlib.util.find_spec(self.law)
-            origin = Path(spec.origin) if spec is not None and spec.origin else None
-            digest = hashlib.sha256(origin.read_bytes()).hexdigest()[:12] if origin and origin.is_file() else "0"
-            law = f"plugin_{_ident(self.law)}_{digest}"
-        return f"k_{law}__{_ident(self.plant.rsplit('.', 1)[-1])}"
+        return f"k_{_part_name(self.law)}__{_part_name(self.plant)}"
 
 
-def _ident(text: str) -> str:
-    return re.sub(r"\W", "_", text)
+def _part_name(spec: str) -> str:
+    """A law's or plant's part of a kernel name: its module's last name, or for a plug-in its name and content hash."""
+    if spec.endswith(".py"):
+        path = Path(spec).resolve()
+        return f"plugin_{_ident(path.stem)}_{file_digest(path)}"
+    if spec.startswith("auvtrack."):
+        return _ident(spec.rsplit(".", 1)[-1])
+    found = importlib.util.find_spec(spec)  # a plug-in given by module name: its full name and the hash of its file
+    origin = Path(found.origin) if found is not None and found.origin else None
+    return f"plugin_{_ident(spec)}_{file_digest(origin) if origin and origin.is_file() else '0'}"
 
 
-def law_module(law: str):
-    """Import the module holding a controller law.
-
-    Parameters
-    ----------
-    law : str
-        An importable module name, or the path of a ``.py`` file (imported once per content under a
-        name derived from its path and hash).
-
-    Returns
-    -------
-    module
-        The module; its ``control`` is the compiled law.
-
-    Raises
-    ------
-    ImportError
-        If the module or file cannot be imported (the message names it).
-    """
-    if not law.endswith(".py"):
-        return importlib.import_module(law)
-    path = Path(law).resolve()
-    if not path.is_file():
-        raise ImportError(f"{path}: no such file")
-    digest = hashlib.sha256(path.read_bytes()).hexdigest()[:12]
-    name = f"auvtrack_plugin_{_ident(path.stem)}_{digest}"
-    if name in sys.modules:
-        return sys.modules[name]
-    spec = importlib.util.spec_from_file_location(name, path)
-    if spec is None or spec.loader is None:
-        raise ImportError(f"{path}: not an importable Python file")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        del sys.modules[name]
-        raise
-    return module
+def _comment(text: str) -> str:
+    """One comment line naming what a user chose (a file name, a label), whatever characters it holds."""
+    return "# " + repr(text)[1:-1]
 
 
 def kernel_source(key: KernelKey) -> str:
@@ -153,17 +114,17 @@ def kernel_source(key: KernelKey) -> str:
         lines = src.splitlines()
         assert lines[0].startswith("@kernel_part("), f"engine.{name}: the marker must be the only decorator"
         parts.append(f"@{decorator}\n" + "\n".join(lines[1:]) + "\n")
-    head = f'''"""Kernel of {key.label or key.name}: generated by auvtrack.engine.kernels; do not edit.
+    head = f'''"""Kernel of one (controller law, plant) pair: generated by auvtrack.engine.kernels; do not edit.
 
-The loop is a copy of auvtrack/engine/loop.py's kernel parts with ``law`` = {key.law}.control
-and ``plant`` = {key.plant}.
+The loop is a copy of auvtrack/engine/loop.py's kernel parts with ``law`` and ``plant`` bound below.
 """
-from auvtrack.engine.jit import llvm_inline, njit, njit_noalloc  # noqa: F401
+{_comment(key.label or key.name)}
+from auvtrack.jit import llvm_inline, njit, njit_noalloc  # noqa: F401
 from auvtrack.engine.loop import *  # noqa: F401,F403
-from auvtrack.engine.kernels import law_module
-from {key.plant.rsplit('.', 1)[0]} import {key.plant.rsplit('.', 1)[1]} as plant
+from auvtrack.user_modules import load_module
 
-law = llvm_inline(law_module({key.law!r}).control)  # one compilation, inlined by LLVM where called
+plant = load_module({key.plant!r})
+law = llvm_inline(load_module({key.law!r}).control)  # one compilation, inlined by LLVM where called
 '''
     tail = "\n\nlog_row.lane_stub = True  # the SIMD batch kernels keep no trajectory (metrics only)\n"
     return head + "\n\n" + "\n\n".join(parts) + tail
@@ -190,13 +151,14 @@ def lanes_source(key: KernelKey) -> str:
         lines = src.splitlines()
         assert lines[0].startswith("@kernel_part("), f"engine.{name}: the marker must be the only decorator"
         parts.append(f"@{decorator}\n" + "\n".join(lines[1:]) + "\n")
-    head = f'''"""SIMD batch kernel of {key.label or key.name}: generated by auvtrack.engine.kernels; do not edit.
+    head = f'''"""SIMD batch kernel of one (controller law, plant) pair: generated by auvtrack.engine.kernels; do not edit.
 
 ``run__lanes`` is the lane form of the kernel's ``run`` (auvtrack.engine.lanes); the loop below
 is a copy of auvtrack/engine/loop.py's lane parts.
 """
-from auvtrack.engine.jit import njit, njit_noalloc  # noqa: F401
-from auvtrack.engine.lane_values import as_lanes, first_lanes, get_lane  # noqa: F401
+{_comment(key.label or key.name)}
+from auvtrack.jit import njit, njit_noalloc  # noqa: F401
+from auvtrack.jit.lane_values import as_lanes, first_lanes, get_lane  # noqa: F401
 from auvtrack.engine.loop import *  # noqa: F401,F403
 from auvtrack.engine.kernels import KernelKey, kernel_module
 from auvtrack.engine.lanes import lane_version
@@ -380,13 +342,14 @@ def example_lane_arguments() -> tuple:
     """Arguments of a lanes module's ``run_lanes`` with the types the SIMD back end passes, over no block.
 
     Each run's arrays stacked in blocks of :data:`~auvtrack.engine.loop.LANES` along a last
-    axis (``auvtrack.batch.runner._LaneGroup``): C-contiguous float64, int64 for ``si``, ``infos``,
-    ``counts`` and ``causes``; ``b0 = b1 = 0``, so a call compiles (or loads) and runs nothing.
+    axis (``auvtrack.batch.runner._LaneGroup``): C-contiguous float64, int64 for ``si``, ``info``,
+    ``counts`` and ``cause``; ``b0 = b1 = 0``, so a call compiles (or loads) and runs nothing.
     """
     L = engine.LANES
     f3, f4, i3 = np.zeros((1, 1, L)), np.zeros((1, 1, 1, L)), np.zeros((1, 1, L), np.int64)
-    return (f3, f3, f3, f3, f3, f4, f4, f4, f3, i3, f3, f4, f3, f4, i3, np.zeros(1, np.int64),
-            np.zeros((1, L), np.int64), np.zeros((1, L)), 0, 0)
+    ins = engine.Stacked(f3, f3, f3, f3, f3, f4, f4, f4, f3, i3, f3)
+    outs = engine.StackedOutputs(f4, f3, f4, i3, np.zeros((1, L), np.int64), np.zeros((1, L)))
+    return ins, outs, np.zeros(1, np.int64), 0, 0
 
 
 def compile_lanes(key: KernelKey) -> bool:

@@ -2,7 +2,7 @@
 
 :func:`lane_version` takes a compiled function (a Numba dispatcher: a controller's law, a plant's
 ``rhs``, the engine's ``stage``, ...) and returns its *lane form*: a function compiled from the
-same Python source, rewritten so that every value may be a :class:`auvtrack.engine.lane_values.Lanes` value
+same Python source, rewritten so that every value may be a :class:`auvtrack.jit.lane_values.Lanes` value
 (one lane per run) and every branch is taken per lane.  The rewrite is mechanical and keeps each
 operation of the source, in order; only control flow changes:
 
@@ -20,7 +20,7 @@ operation of the source, in order; only control flow changes:
 * a call of another compiled function calls its lane form with the current mask.
 
 Arithmetic, comparisons, ``abs``, ``min``, ``max``, ``int``, ``float`` and ``math.*`` work on lanes
-as they are (:mod:`auvtrack.engine.lane_values`: each lane gets exactly the scalar operation), so a lane's
+as they are (:mod:`auvtrack.jit.lane_values`: each lane gets exactly the scalar operation), so a lane's
 result is the scalar function's result for that lane's inputs, bit for bit.  A construct the
 rewrite does not handle raises :class:`NotLaneable`; the SIMD back end then falls back to threads.
 
@@ -40,8 +40,8 @@ from typing import Any
 import numpy as np
 from numba.core.dispatcher import Dispatcher
 
-from . import lane_values as _lanes
-from .jit import njit
+from ..jit import lane_values as _lanes
+from ..jit import njit
 
 __all__ = ["lane_version", "lane_source", "NotLaneable"]
 
@@ -604,7 +604,7 @@ def lane_version(disp):
     Parameters
     ----------
     disp : numba dispatcher
-        A function compiled with :func:`auvtrack.engine.jit.njit` (or ``numba.njit``).
+        A function compiled with :func:`auvtrack.jit.njit` (or ``numba.njit``).
 
     Returns
     -------

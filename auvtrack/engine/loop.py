@@ -16,15 +16,17 @@ steps the loop reads ``info[INFO_STOP]``: a non-zero value (set from another thr
 Ctrl-C) stops the run with cause :data:`CAUSE_INTERRUPTED`.
 
 **How the kernels are made.**  The functions marked ``@kernel_part`` below call the controller's
-compiled law as ``law(...)`` and the plant's compiled functions as ``plant.f(...)`` (the
-contracts: :mod:`auvtrack.control.contract`, ``docs/architecture.md``).  They are not compiled
+compiled law as ``law(...)`` and the plant's compiled functions as ``plant.f(...)``.  Here those
+names are the contracts' documented stubs (:func:`auvtrack.control.contract.control`,
+:mod:`auvtrack.plant.contract`), so this file is plain, checkable Python; it is not compiled
 here: :mod:`auvtrack.engine.kernels` writes, for each (controller, plant) pair a run needs, a
-module that binds ``law`` and ``plant`` and holds a verbatim copy of these functions, and
-compiles it once (cached on disk).  This file is the one source of the loop.
+module that binds ``law`` and ``plant`` to the real ones and holds a verbatim copy of these
+functions, and compiles it once (cached on disk).  This file is the one source of the loop.
 
 Arguments come in bundles (:class:`PlantBundle`, :class:`ControllerBundle`,
-:class:`EnvironmentBundle`, :class:`Settings`, :class:`Outputs`); integer settings ``si`` and
-float settings ``sf`` use the index constants below.
+:class:`EnvironmentBundle`, :class:`Settings`, :class:`Outputs`; :class:`Stacked` and
+:class:`StackedOutputs` for many runs); integer settings ``si`` and float settings ``sf`` follow
+the layouts :data:`SI` and :data:`~auvtrack.plant.contract.SF`.
 
 Performance note: arrays are passed whole and indexed, never sliced, in the hot path (a slice
 is a reference-counted view whose atomic inc/decrements cost more than the arithmetic).
@@ -37,29 +39,29 @@ from typing import NamedTuple
 import numpy as np
 from numba import prange
 
-from .jit import njit, njit_noalloc
-from ..control.contract import WORK_SIZE
+from ..control.contract import WORK_SIZE, LawArgs, LawOutputs, Measured
+from ..control.contract import control as law
 from ..control.tracking import lumped_disturbance
 from ..environment.layout import KIND_PAPER, KIND_PULSE
 from ..environment.sensors import measure
-from ..plant.contract import CAUSE_PITCH, CAUSE_ROLL, SCRATCH_SIZE, SF_PHI_LIM, SF_THETA_LIM
+from ..packing import packed_layout
+from ..plant import contract as plant
+from ..plant.contract import CAUSE_PITCH, CAUSE_ROLL, SCRATCH_SIZE, SF
+from ..reference import eval_reference
+from ..metrics import metrics_update, saturation_update
 from ..vehicle.dynamics import nu_dot
 from ..vehicle.kinematics import attitude, virtual_point
-from ..vehicle.params import ELL
-from ..reference import eval_reference
-from ..simulation.metrics import metrics_update, saturation_update
+from ..vehicle.params import VP
+from ..channels import LOG_ROW
+from ..jit import njit, njit_noalloc
+from ..jit.lane_values import as_lanes, first_lanes, get_lane
 
-SI_NSTEPS, SI_LOG_EVERY, SI_CTRL_EVERY, SI_NAUX = range(4)
-SI_SIZE = 4
-SF_DT, SF_STATE_LIM, SF_WIN_T0, SF_WIN_T1 = 0, 2, 3, 4
-SF_SIZE = 6  # [dt, theta_lim, state_lim, t0, t1, phi_lim]; theta_lim, phi_lim: plant.contract
-assert SF_THETA_LIM == 1 and SF_PHI_LIM == 5
+SI = packed_layout("IntSettings", n_steps=1, log_every=1, ctrl_every=1, n_aux=1)
+"""Engine integer settings: RK4 steps, steps per logged row, steps per control sample (0:
+continuous), the controller's channel count."""
 INFO_STOP, INFO_STEPS = 0, 1
 INFO_SIZE = 2
 STOP_POLL = 1024  # steps between two reads of the stop flag (a power of two)
-
-# logged row: t, eta(5), nu(5), tau(3), eta_d(3), e(3), aux(naux), chi(3), plant channels(N_LOG)
-N_BASE_COLS = 20
 
 CAUSE_NONE, CAUSE_NONFINITE, CAUSE_STATE_LIMIT, CAUSE_INTERRUPTED = 0, 1, 3, 4
 CAUSE_CONTROLLER = 10  # + controller status code
@@ -98,7 +100,7 @@ class EnvironmentBundle(NamedTuple):
 
 
 class Settings(NamedTuple):
-    """Integer settings ``si`` (SI_*) and float settings ``sf`` (SF_*)."""
+    """Integer settings ``si`` (:data:`SI`) and float settings ``sf`` (:data:`~auvtrack.plant.contract.SF`)."""
 
     si: np.ndarray
     sf: np.ndarray
@@ -116,6 +118,55 @@ class Outputs(NamedTuple):
     acc: np.ndarray
     fail_state: np.ndarray
     info: np.ndarray
+
+
+class Loop(NamedTuple):
+    """What every stage of one run reads: plant, controller, reference, environment, control mode."""
+
+    pp: np.ndarray
+    cp: np.ndarray
+    vp: np.ndarray
+    path: np.ndarray
+    rows: np.ndarray
+    current: np.ndarray
+    ctrl_every: int
+    h: float
+
+
+class Buffers(NamedTuple):
+    """Arrays one run reuses at every stage: reference rows, law scratch, plant scratch, actuator command."""
+
+    refm: np.ndarray
+    work: np.ndarray
+    scr: np.ndarray
+    cmd: np.ndarray
+
+
+class Stacked(NamedTuple):
+    """The inputs of many runs with equal array shapes: row ``i`` of each is run ``i``'s array."""
+
+    pp: np.ndarray
+    xp0: np.ndarray
+    cp: np.ndarray
+    xc0: np.ndarray
+    vp: np.ndarray
+    rows: np.ndarray
+    current: np.ndarray
+    noise: np.ndarray
+    path: np.ndarray
+    si: np.ndarray
+    sf: np.ndarray
+
+
+class StackedOutputs(NamedTuple):
+    """What many runs write: logs, metrics accumulators, stop states, step counts, causes and stop times."""
+
+    log: np.ndarray
+    acc: np.ndarray
+    fail_state: np.ndarray
+    info: np.ndarray
+    cause: np.ndarray
+    t_stop: np.ndarray
 
 
 KERNEL_PARTS: dict[str, str] = {}
@@ -155,8 +206,13 @@ def example_arguments() -> tuple:
     """
     f1, f2 = np.zeros(1), np.zeros((1, 1))
     return (PlantBundle(f1, f1), ControllerBundle(f1, f1, f1), EnvironmentBundle(f2, f2, f2), f1,
-            Settings(np.zeros(SI_SIZE, np.int64), np.zeros(SF_SIZE)),
+            Settings(np.zeros(SI.size, np.int64), np.zeros(SF.size)),
             Outputs(f2, f1, f2, np.zeros(INFO_SIZE, np.int64)))
+
+
+def run__lanes(pb, cb, env, ref_p, settings, out, mask):
+    """The lane form of :func:`run` (:mod:`auvtrack.engine.lanes`); each SIMD batch module binds its own."""
+    raise NotImplementedError("bound per lane kernel")
 
 
 # ------------------------------------------------------------------ helpers (compiled here)
@@ -204,12 +260,12 @@ def record_stop(xp, xc, xp_last, xc_last, fail_state):
 @kernel_part("njit_noalloc(inline='always')")
 def state_cause(xp, xc, sf):
     """Failure cause after a step (precedence: non-finite, the plant's attitude limits, state limit)."""
-    nf_p, over_p = scan_state(xp, sf[SF_STATE_LIM])
-    nf_c, over_c = scan_state(xc, sf[SF_STATE_LIM])
+    nf_p, over_p = scan_state(xp, sf[SF.state_lim])
+    nf_c, over_c = scan_state(xc, sf[SF.state_lim])
     nonfinite, over = nf_p or nf_c, over_p or over_c
     if nonfinite:
         return CAUSE_NONFINITE
-    cause = plant.attitude_cause(xp, sf)  # noqa: F821  (bound per kernel)
+    cause = plant.attitude_cause(xp, sf)
     if cause != CAUSE_NONE:
         return cause
     if over:
@@ -220,38 +276,47 @@ def state_cause(xp, xc, sf):
 @kernel_part("njit_noalloc(inline='always')")
 def plant_attitude(xp):
     """(cos theta, sin theta, cos psi, sin psi) of the plant state, through its 5-DOF ``pose``."""
-    eta = plant.pose(xp)[0]  # noqa: F821  (bound per kernel)
+    eta = plant.pose(xp)[0]
     return attitude(eta[3], eta[4])
 
 
+@kernel_part("njit_noalloc(inline='always')")
+def law_call(t, eta, nu, att, xc, xp, lp, buf, out):
+    """The law at the measured (eta, nu, att), told what the actuators can do at the plant state ``xp``."""
+    lo, hi, ap = plant.feedback(xp, buf.cmd, lp.pp)
+    return law(t, Measured(eta, nu, att), xc, LawArgs(buf.refm, lp.path, lp.cp, lp.vp, lo, hi, ap, lp.h, buf.work),
+               out)
+
+
 @kernel_part("njit_noalloc")
-def stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd, dxp, dxc, tau, aux,
-          fresh):
-    """One right-hand-side evaluation: write dxp (and dxc); return (controller status, saturation flags).
+def stage(t, xp, xc, att, lp, buf, dxp, out, fresh):
+    """One right-hand-side evaluation: write dxp (and ``out.dxc``); return (controller status, saturation flags).
 
     ``att`` is the attitude of ``xp`` (computed once per stage by the caller).  In continuous
-    mode the law and the plant's allocation run here (``cmd`` is the previous command when the
-    allocation starts and the new one after it); in sampled-data mode ``cmd`` holds the sample's
-    command and the caller has filled dxc with the held controller derivative.  With ``fresh``
-    false the reference and the plant's cached disturbance of the previous call are reused: the
-    loop passes false only for the second of two stages at the same time whose disturbance does
-    not depend on the state (RK4 stages 2 and 3), so the values are the same numbers.
+    mode the law and the plant's allocation run here (``buf.cmd`` is the previous command when
+    the allocation starts and the new one after it); in sampled-data mode ``buf.cmd`` holds the
+    sample's command and the caller has filled ``out.dxc`` with the held controller derivative.
+    With ``fresh`` false the reference and the plant's cached disturbance of the previous call are
+    reused: the loop passes false only for the second of two stages at the same time whose
+    disturbance does not depend on the state (RK4 stages 2 and 3), so the values are the same
+    numbers.
     """
     if fresh:
-        eval_reference(ref_p, t, refm)
+        eval_reference(lp.path, t, buf.refm)
     flags = 0
-    if ctrl_every == 0:
-        eta, nu = plant.pose(xp)  # noqa: F821
-        status = law(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work)  # noqa: F821
+    if lp.ctrl_every == 0:
+        eta, nu = plant.pose(xp)
+        status = law_call(t, eta, nu, att, xc, xp, lp, buf, out)
         if status != 0:
             return status, flags
-        flags = plant.allocate((tau[0], tau[1], tau[2]), eta, nu, xp, pp, cmd, 0.0, cmd)  # noqa: F821
-    plant.rhs(t, xp, att, cmd, (rows, current), pp, scr, fresh, dxp)  # noqa: F821
+        u = out.u
+        flags = plant.allocate((u[0], u[1], u[2]), eta, nu, xp, lp.pp, buf.cmd, 0.0, buf.cmd)
+    plant.rhs(t, xp, att, buf.cmd, (lp.rows, lp.current), lp.pp, buf.scr, fresh, dxp)
     return 0, flags
 
 
 @kernel_part("njit_noalloc")
-def control_sample(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control_sample(t, eta, nu, att, xc, xp, lp, buf, out):
     """The law at one control sample (sampled-data mode), behind a call.
 
     A law compiled with ``inline="always"`` is copied into every function that calls it; called
@@ -259,52 +324,54 @@ def control_sample(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
     it runs at every stage, and here), which halves what Numba compiles of it.  Once per sample,
     the call costs nothing measurable.
     """
-    return law(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work)  # noqa: F821
+    return law_call(t, eta, nu, att, xc, xp, lp, buf, out)
 
 
 @kernel_part("njit")
 def log_row(log, row, t, xp, cmd, pp, tau, refm, e, aux, naux, dxp, vp):
-    """Fill one logged row (see N_BASE_COLS); chi uses the nominal model with the produced input."""
-    eta, nu = plant.pose(xp)  # noqa: F821
-    log[row, 0] = t
+    """Fill one logged row (:data:`~auvtrack.channels.LOG_ROW`); chi uses the nominal model with the produced input."""
+    eta, nu = plant.pose(xp)
+    log[row, LOG_ROW.t] = t
     for i in range(5):
-        log[row, 1 + i] = eta[i]
-        log[row, 6 + i] = nu[i]
+        log[row, LOG_ROW.eta + i] = eta[i]
+        log[row, LOG_ROW.nu + i] = nu[i]
     for i in range(3):
-        log[row, 11 + i] = tau[i]
-        log[row, 14 + i] = refm[0, i]
-        log[row, 17 + i] = e[i]
+        log[row, LOG_ROW.tau + i] = tau[i]
+        log[row, LOG_ROW.eta_d + i] = refm[0, i]
+        log[row, LOG_ROW.e + i] = e[i]
     for i in range(naux):
-        log[row, 20 + i] = aux[i]
+        log[row, LOG_ROW.size + i] = aux[i]
     att = attitude(eta[3], eta[4])
     dnu_nom = nu_dot(att, nu, tau, (0.0, 0.0, 0.0, 0.0, 0.0), vp)
-    chi = lumped_disturbance(att, plant.accel5(dxp), dnu_nom, vp[ELL])  # noqa: F821
-    log[row, 20 + naux], log[row, 21 + naux], log[row, 22 + naux] = chi
-    plant.log_extra(xp, cmd, pp, log, row, 23 + naux)  # noqa: F821
+    chi = lumped_disturbance(att, plant.accel5(dxp), dnu_nom, vp[VP.ell])
+    col = LOG_ROW.size + naux
+    log[row, col], log[row, col + 1], log[row, col + 2] = chi
+    plant.log_extra(xp, cmd, pp, log, row, col + 3)
 
 
 @kernel_part("njit(nogil=True)")
 def run(pb, cb, env, ref_p, settings, out):
     """Integrate the closed loop; return (cause, rows_logged, t_stop).
 
-    ``out.log`` has shape (n_rows, N_BASE_COLS + naux + 3 + plant.N_LOG); ``out.acc`` is the
-    metrics accumulator (initialised by :func:`~auvtrack.simulation.metrics.metrics_init`).
+    ``out.log`` has shape (n_rows, len(channels)) (:func:`~auvtrack.channels.channel_names`);
+    ``out.acc`` is the metrics accumulator (initialised by :func:`~auvtrack.metrics.metrics_init`).
     """
     si, sf = settings.si, settings.sf
     log, acc, fail_state, info = out.log, out.acc, out.fail_state, out.info
     pp, cp, vp = pb.pp, cb.cp, cb.vp
-    rows, current = env.rows, env.current
     nxp, nxc = pb.x0.shape[0], cb.x0.shape[0]
-    n_steps, log_every, ctrl_every = si[SI_NSTEPS], si[SI_LOG_EVERY], si[SI_CTRL_EVERY]
-    naux = si[SI_NAUX]
-    dt = sf[SF_DT]
+    n_steps, log_every, ctrl_every = si[SI.n_steps], si[SI.log_every], si[SI.ctrl_every]
+    naux = si[SI.n_aux]
+    dt = sf[SF.dt]
     xp, xc = pb.x0.copy(), cb.x0.copy()
     xpn, xcn = np.empty(nxp), np.empty(nxc)  # the state after a step, checked before it is taken
     xps, xcs = np.empty(nxp), np.empty(nxc)
     kp1, kp2, kp3, kp4 = np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp)
     kc1, kc2, kc3, kc4 = np.zeros(nxc), np.zeros(nxc), np.zeros(nxc), np.zeros(nxc)
-    refm, work, scr = np.zeros((3, 3)), np.zeros(WORK_SIZE), np.zeros(SCRATCH_SIZE)
-    cmd, cmd_sample = np.zeros(plant.N_CMD), np.zeros(plant.N_CMD)  # noqa: F821
+    cmd, cmd_sample = np.zeros(plant.N_CMD), np.zeros(plant.N_CMD)
+    buf = Buffers(np.zeros((3, 3)), np.zeros(WORK_SIZE), np.zeros(SCRATCH_SIZE), cmd)
+    refm = buf.refm
+    lp = Loop(pp, cp, vp, ref_p, env.rows, env.current, ctrl_every, ctrl_every * dt)
     sat = 0  # saturation flags of the command in force
     tau1, tau = np.zeros(3), np.zeros(3)
     aux1, aux = np.zeros(max(naux, 1)), np.zeros(max(naux, 1))
@@ -318,24 +385,23 @@ def run(pb, cb, env, ref_p, settings, out):
             return CAUSE_INTERRUPTED, row, t
         if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, allocate, hold
             eval_reference(ref_p, t, refm)
-            eta_t, nu_t = plant.pose(xp)  # noqa: F821
+            eta_t, nu_t = plant.pose(xp)
             eta, nu = measure(eta_t, nu_t, env.noise, k // ctrl_every)
-            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, refm, vp, cp, tau1, kc1, aux1, work)
+            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf,
+                                    LawOutputs(tau1, kc1, aux1))
             if status == 0 and not finite3(tau1):
                 status = STATUS_NONFINITE_INPUT
             if status != 0:
                 record_stop(xp, xc, xp, xc, fail_state)
                 return CAUSE_CONTROLLER + status, row, t
-            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt,  # noqa: F821
-                                 cmd_sample)
+            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt, cmd_sample)
             for i in range(cmd_sample.shape[0]):
                 cmd[i] = cmd_sample[i]
             for i in range(nxc):  # the held controller derivative, for every stage until the next sample
                 kc2[i] = kc3[i] = kc4[i] = kc1[i]
         # stage 1 at (t, x): also the values that are logged and enter the metrics
         att = plant_attitude(xp)
-        status, flags = stage(t, xp, xc, att, ctrl_every, cp, vp, pp, ref_p, rows, current, refm, work, scr, cmd,
-                              kp1, kc1, tau1, aux1, True)
+        status, flags = stage(t, xp, xc, att, lp, buf, kp1, LawOutputs(tau1, kc1, aux1), True)
         if ctrl_every == 0:
             sat = flags
         if status == 0 and ctrl_every == 0 and not finite3(tau1):
@@ -343,37 +409,35 @@ def run(pb, cb, env, ref_p, settings, out):
         if status != 0:
             record_stop(xp, xc, xp, xc, fail_state)
             return CAUSE_CONTROLLER + status, row, t
-        applied = plant.applied(xp, cmd, pp)  # noqa: F821
-        eta, nu = plant.pose(xp)  # noqa: F821
-        p1 = virtual_point(eta, att, vp[ELL])
+        applied = plant.applied(xp, cmd, pp)
+        eta, nu = plant.pose(xp)
+        p1 = virtual_point(eta, att, vp[VP.ell])
         e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
         if k % log_every == 0 and row < log.shape[0]:
             log_row(log, row, t, xp, cmd, pp, applied, refm, e, aux1, naux, kp1, vp)
             row += 1
         if k == n_steps:
             break
-        metrics_update(acc, t, dt, e, applied, sf[SF_WIN_T0], sf[SF_WIN_T1])
-        saturation_update(acc, t, dt, sat, sf[SF_WIN_T0], sf[SF_WIN_T1])
+        metrics_update(acc, t, dt, e, applied, sf[SF.win_t0], sf[SF.win_t1])
+        saturation_update(acc, t, dt, sat, sf[SF.win_t0], sf[SF.win_t1])
         for i in range(nxp):
             xps[i] = xp[i] + 0.5 * dt * kp1[i]
         for i in range(nxc):
             xcs[i] = xc[i] + 0.5 * dt * kc1[i]
-        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p, rows,
-                          current, refm, work, scr, cmd, kp2, kc2, tau, aux, True)
+        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, LawOutputs(tau, kc2, aux), True)
         if status == 0:
             for i in range(nxp):
                 xps[i] = xp[i] + 0.5 * dt * kp2[i]
             for i in range(nxc):
                 xcs[i] = xc[i] + 0.5 * dt * kc2[i]
-            status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p,
-                              rows, current, refm, work, scr, cmd, kp3, kc3, tau, aux, not reuse)
+            status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, LawOutputs(tau, kc3, aux),
+                              not reuse)
         if status == 0:
             for i in range(nxp):
                 xps[i] = xp[i] + dt * kp3[i]
             for i in range(nxc):
                 xcs[i] = xc[i] + dt * kc3[i]
-            status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), ctrl_every, cp, vp, pp, ref_p, rows,
-                              current, refm, work, scr, cmd, kp4, kc4, tau, aux, True)
+            status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, LawOutputs(tau, kc4, aux), True)
         if status != 0:
             record_stop(xp, xc, xp, xc, fail_state)
             return CAUSE_CONTROLLER + status, row, t
@@ -394,45 +458,42 @@ def run(pb, cb, env, ref_p, settings, out):
 
 
 @kernel_part("njit(nogil=True, parallel=True)")
-def run_many(pps, xp0s, cps, xc0s, vps, rowss, curs, noises, refs, sis, sfs, ncols, accs, fails, infos, causes,
-             t_stops):
-    """:func:`run` of ``len(pps)`` runs of identical array shapes in a ``prange`` loop, metrics only.
+def run_many(ins, ncols, outs):
+    """:func:`run` of ``len(ins.pp)`` runs of identical array shapes in a ``prange`` loop, metrics only.
 
-    Row ``i`` of every stacked argument is run ``i``'s array; writes ``accs``, ``fails``,
-    ``infos``, ``causes`` and ``t_stops``.
+    ``ins`` is a :class:`Stacked`, ``outs`` a :class:`StackedOutputs` (its ``log`` unused).
     """
-    for i in prange(pps.shape[0]):
+    for i in prange(ins.pp.shape[0]):
         log = np.empty((0, ncols))
-        cause, _, t_stop = run(PlantBundle(pps[i], xp0s[i]), ControllerBundle(cps[i], xc0s[i], vps[i]),
-                               EnvironmentBundle(rowss[i], curs[i], noises[i]), refs[i], Settings(sis[i], sfs[i]),
-                               Outputs(log, accs[i], fails[i], infos[i]))
-        causes[i] = cause
-        t_stops[i] = t_stop
+        cause, _, t_stop = run(PlantBundle(ins.pp[i], ins.xp0[i]), ControllerBundle(ins.cp[i], ins.xc0[i], ins.vp[i]),
+                               EnvironmentBundle(ins.rows[i], ins.current[i], ins.noise[i]), ins.path[i],
+                               Settings(ins.si[i], ins.sf[i]), Outputs(log, outs.acc[i], outs.fail_state[i],
+                                                                       outs.info[i]))
+        outs.cause[i] = cause
+        outs.t_stop[i] = t_stop
 
 
 @kernel_part("njit(nogil=True)", lanes=True)
-def run_lanes(pps, xp0s, cps, xc0s, vps, rowss, curs, noises, refs, sis, sfs, logs, accs, fails, infos, counts, causes,
-              t_stops, b0, b1):
+def run_lanes(ins, outs, counts, b0, b1):
     """:func:`run` of LANES runs at once, one per lane of a SIMD register, for the blocks b0 .. b1 - 1.
 
-    Block ``b`` of every argument holds ``counts[b]`` runs along its last axis (length LANES; the
-    lanes beyond ``counts[b]`` are padding and never written back).  ``run__lanes`` is the lane
-    form of :func:`run` (:mod:`auvtrack.engine.lanes`): the same loop, each run's branches
-    taken in its own lane, a run that stops leaving its lane with its own cause and time.  Writes
-    ``accs``, ``fails``, ``infos`` (the runs' metrics accumulators, stop states and steps) and
-    ``causes``, ``t_stops`` (block, lane).
+    Block ``b`` of every array of ``ins`` (:class:`Stacked`) and ``outs`` (:class:`StackedOutputs`)
+    holds ``counts[b]`` runs along its last axis (length LANES; the lanes beyond ``counts[b]`` are
+    padding and never written back).  ``run__lanes`` is the lane form of :func:`run`
+    (:mod:`auvtrack.engine.lanes`): the same loop, each run's branches taken in its own lane, a run
+    that stops leaving its lane with its own cause and time.
     """
     for b in range(b0, b1):
-        m = first_lanes(counts[b], LANES)  # noqa: F821  (bound in the lanes module)
-        out = Outputs(as_lanes(logs[b], LANES), as_lanes(accs[b], LANES), as_lanes(fails[b], LANES),  # noqa: F821
-                      as_lanes(infos[b], LANES))  # noqa: F821
-        cause, _, t_stop = run__lanes(PlantBundle(as_lanes(pps[b], LANES), as_lanes(xp0s[b], LANES)),  # noqa: F821
-                                      ControllerBundle(as_lanes(cps[b], LANES), as_lanes(xc0s[b], LANES),  # noqa: F821
-                                                       as_lanes(vps[b], LANES)),  # noqa: F821
-                                      EnvironmentBundle(as_lanes(rowss[b], LANES), as_lanes(curs[b], LANES),  # noqa: F821
-                                                        as_lanes(noises[b], LANES)),  # noqa: F821
-                                      as_lanes(refs[b], LANES), Settings(as_lanes(sis[b], LANES),  # noqa: F821
-                                                                          as_lanes(sfs[b], LANES)), out, m)  # noqa: F821
+        m = first_lanes(counts[b], LANES)
+        out = Outputs(as_lanes(outs.log[b], LANES), as_lanes(outs.acc[b], LANES),
+                      as_lanes(outs.fail_state[b], LANES), as_lanes(outs.info[b], LANES))
+        cause, _, t_stop = run__lanes(PlantBundle(as_lanes(ins.pp[b], LANES), as_lanes(ins.xp0[b], LANES)),
+                                      ControllerBundle(as_lanes(ins.cp[b], LANES), as_lanes(ins.xc0[b], LANES),
+                                                       as_lanes(ins.vp[b], LANES)),
+                                      EnvironmentBundle(as_lanes(ins.rows[b], LANES), as_lanes(ins.current[b], LANES),
+                                                        as_lanes(ins.noise[b], LANES)),
+                                      as_lanes(ins.path[b], LANES),
+                                      Settings(as_lanes(ins.si[b], LANES), as_lanes(ins.sf[b], LANES)), out, m)
         for k in range(counts[b]):
-            causes[b, k] = get_lane(cause, k)  # noqa: F821
-            t_stops[b, k] = get_lane(t_stop, k)  # noqa: F821
+            outs.cause[b, k] = get_lane(cause, k)
+            outs.t_stop[b, k] = get_lane(t_stop, k)

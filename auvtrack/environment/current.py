@@ -37,9 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.jit import njit_noalloc
+from ..jit import njit_noalloc
 from ..vehicle.kinematics import attitude, body_from_ned
-from ..vehicle.params import D0
+from ..vehicle.params import VP
 from . import _validate as val
 from .layout import C_DT, C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, ROW_SIZE
 
@@ -157,6 +157,6 @@ def add_current_force(vx, vy, vz, eta, vp, out):
     V_c = (vx, vy, vz) is the NED current (m/s); J1^T is :func:`~auvtrack.vehicle.kinematics.body_from_ned`.
     """
     uc, vc, wc = body_from_ned(attitude(eta[3], eta[4]), (vx, vy, vz))
-    out[0] += vp[D0] * uc
-    out[1] += vp[D0 + 1] * vc
-    out[2] += vp[D0 + 2] * wc
+    out[0] += vp[VP.d] * uc
+    out[1] += vp[VP.d + 1] * vc
+    out[2] += vp[VP.d + 2] * wc

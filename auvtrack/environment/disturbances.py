@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.jit import njit_noalloc
-from ..engine.vecmath import sincos4
+from ..jit import njit_noalloc
+from ..jit.vecmath import sincos4
 from . import _validate as val
 from .layout import KIND_PAPER, KIND_PULSE, P_AMP, P_PHASE, ROW_SIZE, U_END, U_FORCE, U_START
 

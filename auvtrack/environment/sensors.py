@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._seeding import rng
-from ..engine.jit import njit_noalloc
+from ..jit import njit_noalloc
 
 N_MEAS = 10
 

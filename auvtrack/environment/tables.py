@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
 from .._seeding import rng
-from ..vehicle.params import VP_SIZE
+from ..vehicle.params import VP
 from .current import GaussMarkovCurrent, add_current_force, current_velocity
 from .disturbances import PaperDisturbance, Pulse, add_paper, add_pulse
 from .layout import C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, KIND_PAPER, KIND_PULSE, ROW_SIZE
@@ -144,7 +144,7 @@ class DisturbanceTables:
         if vp is None:
             if self.has_current:
                 raise ValueError("vp (packed vehicle) is required to evaluate a current's force")
-            vp = np.zeros(VP_SIZE)
+            vp = np.zeros(VP.size)
         vp = np.ascontiguousarray(vp, dtype=np.float64)
         eta, nu = _vec(eta, 5, "eta"), _vec(nu, 5, "nu")
         ts = np.asarray(t, dtype=np.float64)

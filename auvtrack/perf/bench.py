@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 
-from ..engine import jit as _jit
+from .. import jit as _jit
 from ..scenario import paper_scenario_path
 from ..simulation.compiling import builtin_controllers
 
@@ -19,7 +19,7 @@ def machine() -> dict:
     """Short description of this machine for benchmark records (CPU model, cores, load, versions, vector math)."""
     import numba
 
-    from ..engine.vecmath import BACKEND
+    from ..jit.vecmath import BACKEND
 
     cpu = platform.processor() or platform.machine()
     try:

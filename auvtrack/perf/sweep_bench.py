@@ -257,7 +257,7 @@ def write_results(doc: dict, out: Path) -> None:
     lines = ["# Benchmark results", "",
              f"Measured {doc['date']} with `auvtrack bench --all` on {m['cpu']}, {m['cores']} cores, "
              f"Python {m['python']}, Numba {m['numba']}, vector math {m.get('vector_math', 'scalar')} "
-             "(`auvtrack.engine.vecmath`); "
+             "(`auvtrack.jit.vecmath`); "
              f"load average at the start {m['load_avg_1_5_15']} "
              "(a shared, noisy machine: medians of "
              f"{doc['repeat']} repetitions, {3 * doc['repeat']} for the single runs, taken round-robin over the "

@@ -1,11 +1,36 @@
-"""Plants: vehicle models (kinematics, kinetics, presets), actuators, and the registry of truth models.
+"""Plants: the truth models the engine integrates (the 5-DOF model, the 6-DOF REMUS 100), and plug-in plants.
 
-Registering a plant is one line here: ``register(PlantSpec.from_module(module))``.
+Registering a plant is one line here: ``register(module)`` (checked against
+:mod:`auvtrack.plant.contract`).  ``plugin`` is registered after them: it is the loader of plants
+from outside the package (``plant.model = "plugin"``).
 """
-from . import five_dof, sixdof
-from .registry import PLANTS, CompiledPlant, PlantSpec, get, register
+from . import five_dof, plugin, sixdof
+from .registry import PLANTS, CompiledPlant, PlantContext, PlantSpec, check_plant, get, register
 
-register(PlantSpec.from_module(five_dof))
-register(PlantSpec.from_module(sixdof))
+BUILTIN = (five_dof, sixdof)
+BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
+"""Models of the built-in plants (``plugin``, the loader of outside plants, is not one)."""
+for _module in BUILTIN:
+    register(_module)
+register(PlantSpec(plugin.NAME, plugin.__name__, plugin.Section, plugin.setup,
+                   "a plant module from outside the package (plant.module)", accepts=("tau", "actuators")))
 
-__all__ = ["PLANTS", "CompiledPlant", "PlantSpec", "get", "register"]
+__all__ = ["BUILTIN", "BUILTIN_NAMES", "PLANTS", "CompiledPlant", "PlantContext", "PlantSpec", "check_plant", "get", "register", "spec_for"]
+
+
+def spec_for(section) -> PlantSpec:
+    """The record of the plant a validated ``[plant]`` section selects (a plug-in's own for ``"plugin"``).
+
+    Parameters
+    ----------
+    section : pydantic model
+        The scenario's ``[plant]``.
+
+    Returns
+    -------
+    PlantSpec
+        The registered record, or the plug-in's checked record.
+    """
+    if section.model == plugin.NAME:
+        return plugin.spec_of(section)
+    return get(section.model)

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
 
 ACT_TAU_MAX, ACT_RATE_MAX = 0, 3
 ACT_SIZE = 6

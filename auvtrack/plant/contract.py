@@ -1,11 +1,92 @@
-"""Numbers shared by the engine and every plant module (kept apart to avoid import cycles).
+"""The plant contract: what a plant module declares, and the compiled functions the engine calls.
 
-A plant's ``attitude_cause(x, sf)`` reads its limits from the engine's float settings ``sf`` at
-these indices and returns one of these causes (0 = none).  The whole contract is in
-``docs/architecture.md`` ("The plant contract").
+A plant is one module (a built-in registered in :mod:`auvtrack.plant`, or a plug-in file selected
+with ``plant.model = "plugin"`` and ``plant.module``) with
+
+===============  ===================================================================================
+``NAME``         its ``plant.model``
+``STATE``        names of its state components, in order (``NX = len(STATE)``)
+``COMMAND``      names of its actuator-command components (``N_CMD``)
+``LOG_NAMES``    names of the extra channels it logs (``N_LOG``)
+``ACCEPTS``      what a controller may command: ``("tau",)`` or ``("tau", "actuators")``
+``Section``      pydantic model of its ``[plant]`` section (``model: Literal[NAME]``)
+``setup``        ``setup(section, ctx) -> CompiledPlant``: packed parameters, initial state, record
+compiled         the functions below (``njit_noalloc``: no allocation, arrays indexed, not sliced)
+===============  ===================================================================================
+
+:func:`~auvtrack.plant.registry.check_plant` checks all of this at registration and for a
+plug-in, naming the file and the missing or wrong piece.  The stubs below document the compiled
+functions; the engine's loop template (:mod:`auvtrack.engine.loop`) calls them through the name
+``plant``, which each generated kernel binds to the plant's own module.
+
+The float settings ``sf`` the engine hands to :func:`attitude_cause` follow :data:`SF`.
 """
-SF_THETA_LIM = 1  # |pitch| limit, rad
-SF_PHI_LIM = 5  # |roll| limit, rad (6-DOF plants)
+from __future__ import annotations
+
+from ..packing import packed_layout
+
+SF = packed_layout("FloatSettings", dt=1, theta_lim=1, state_lim=1, win_t0=1, win_t1=1, phi_lim=1)
+"""Engine float settings: RK4 step (s), |pitch| and |roll| limits (rad), state limit, metrics window (s)."""
 CAUSE_PITCH = 2
 CAUSE_ROLL = 5
 SCRATCH_SIZE = 16  # length of the scratch array ``scr`` kept between a plant's rhs calls
+
+NX = N_CMD = N_LOG = 0  # a plant module's own (len(STATE), len(COMMAND), len(LOG_NAMES))
+
+
+def pose(x):
+    """(eta, nu): the 5-DOF projection of the state that controllers see.
+
+    ``eta`` = (x, y, z, theta, psi) (m, rad), ``nu`` = (u, v, w, q, r) (m/s, rad/s), as 5-tuples.
+    """
+    raise NotImplementedError
+
+
+def accel5(dx):
+    """(u_dot, v_dot, w_dot, q_dot, r_dot) of a state derivative (for the lumped disturbance chi)."""
+    raise NotImplementedError
+
+
+def allocate(tau3, eta, nu, x, pp, prev, h, cmd):
+    """Write the actuator command ``cmd`` for the controller's 3-vector ``tau3`` at the measured state.
+
+    ``prev`` is the command in force (in continuous mode ``prev`` and ``cmd`` are the same array:
+    read it before writing), ``h`` the sampling period (0 in continuous mode).  Returns a bitmask
+    of the axes whose command could not be produced (the ``t_sat_tau_*`` metrics).
+    """
+    raise NotImplementedError
+
+
+def rhs(t, x, att, cmd, env, pp, scr, fresh, dx):
+    """Write dx = f(t, x, cmd).
+
+    ``att`` is the attitude of x, ``env`` = (disturbance rows, current table), ``scr`` a scratch
+    array kept between calls, ``fresh`` false when t and a state-free disturbance are unchanged
+    since the last call.
+    """
+    raise NotImplementedError
+
+
+def applied(x, cmd, pp):
+    """(tau_u, tau_q, tau_r) the actuators produce now (logged, and used by the metrics)."""
+    raise NotImplementedError
+
+
+def feedback(x, cmd, pp):
+    """(lo, hi, applied) for the controller, each a 3-tuple in the units it commands.
+
+    ``lo`` and ``hi`` bound what each axis's actuators can produce now (tau at the current speed,
+    or the actuators' own limits for a controller that commands them), ``applied`` is what they
+    produce now (:class:`~auvtrack.control.contract.LawArgs`).
+    """
+    raise NotImplementedError
+
+
+def attitude_cause(x, sf):
+    """A plant-specific stop (:data:`CAUSE_PITCH`, :data:`CAUSE_ROLL`) or 0, from the limits in ``sf``."""
+    raise NotImplementedError
+
+
+def log_extra(x, cmd, pp, log, row, col):
+    """Write the plant's extra channels into ``log[row, col:col + N_LOG]``."""
+    raise NotImplementedError

@@ -1,17 +1,17 @@
 """The 5-DOF plant: the paper's eq. (1) driven directly by tau = [tau_u, tau_q, tau_r].
 
-States ``x`` (``NX = 10``): eta = (x, y, z, theta, psi) (m, rad; NED, roll neglected) and
-nu = (u, v, w, q, r) (m/s, rad/s; body).  Actuator command ``cmd`` (``N_CMD = 3``): the applied
+States ``x`` (:data:`STATE`): eta = (x, y, z, theta, psi) (m, rad; NED, roll neglected) and
+nu = (u, v, w, q, r) (m/s, rad/s; body).  Actuator command ``cmd`` (:data:`COMMAND`): the applied
 tau (N, N m, N m) after the magnitude saturation and, in sampled-data mode, the slew-rate limit
-of :mod:`auvtrack.plant.actuators`.  No extra logged channels.
+of :mod:`auvtrack.plant.actuators`.  No extra logged channels.  Its ``[plant]`` section has no keys
+of its own: the vehicle is ``[vehicle]`` with ``[uncertainty]``, the input limits ``[actuator]``.
 
 Packed parameters ``pp`` = [vp_true (13, layout of :mod:`auvtrack.vehicle.params`), tau_max (3),
 rate_max (3)]: the true vehicle (the scenario's ``[uncertainty]`` applied to its preset) and the
 actuator limits.  Disturbance: omega of :func:`auvtrack.environment.eval_disturbance`, with the
 current as the damping force on the relative velocity.
 
-This is ``plant.model = "5dof"``, the default: the same arithmetic as the engine before plants
-became pluggable (bit-identical trajectories, tested).
+This is ``plant.model = "5dof"``, the default.
 
 References
 ----------
@@ -20,20 +20,26 @@ Control, 2nd ed., ch. 8 (currents) and ch. 11 (actuator limits).
 """
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 
-from ..engine.jit import njit_noalloc
+from ..jit import njit_noalloc
 from ..environment import eval_disturbance
-from .actuators import ACT_SIZE, pack_actuator, rate_limit, saturate
-from .contract import CAUSE_PITCH, SF_THETA_LIM
+from .actuators import ACT_SIZE, ACT_TAU_MAX, pack_actuator, rate_limit, saturate
+from .contract import CAUSE_PITCH, SF
 from ..vehicle.dynamics import nu_dot
 from ..vehicle.kinematics import eta_dot
-from ..vehicle.params import VP_SIZE
-from .registry import CompiledPlant
+from ..vehicle.params import VP
+from .registry import CompiledPlant, PlantSection
 
 NAME = "5dof"
-NX, N_CMD, N_LOG = 10, 3, 0
-PP_ACT = VP_SIZE  # actuator limits start here in pp
+STATE = ("x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r")
+COMMAND = ("tau_u", "tau_q", "tau_r")
+LOG_NAMES: tuple[str, ...] = ()
+ACCEPTS = ("tau",)
+NX, N_CMD, N_LOG = len(STATE), len(COMMAND), len(LOG_NAMES)
+PP_ACT = VP.size  # actuator limits start here in pp
 
 
 @njit_noalloc
@@ -79,10 +85,17 @@ def applied(x, cmd, pp):
     return cmd[0], cmd[1], cmd[2]
 
 
+@njit_noalloc(inline="always")
+def feedback(x, cmd, pp):
+    """(lo, hi, applied): the magnitude limits of tau (-tau_max, tau_max) and the applied tau (N, N m)."""
+    a = VP.size + ACT_TAU_MAX
+    return (-pp[a], -pp[a + 1], -pp[a + 2]), (pp[a], pp[a + 1], pp[a + 2]), (cmd[0], cmd[1], cmd[2])
+
+
 @njit_noalloc
 def attitude_cause(x, sf):
-    """CAUSE_PITCH when |theta| exceeds ``sf[SF_THETA_LIM]`` (rad), else 0."""
-    return CAUSE_PITCH if abs(x[3]) > sf[SF_THETA_LIM] else 0
+    """CAUSE_PITCH when |theta| exceeds ``sf[SF.theta_lim]`` (rad), else 0."""
+    return CAUSE_PITCH if abs(x[3]) > sf[SF.theta_lim] else 0
 
 
 @njit_noalloc
@@ -91,13 +104,50 @@ def log_extra(x, cmd, pp, log, row, col):
     return
 
 
-def setup(scenario) -> CompiledPlant:
-    """Pack the true 5-DOF vehicle and actuator limits of ``scenario`` and its initial state."""
-    from ..vehicle.presets import vehicle_arrays
+class Section(PlantSection):
+    """``[plant]`` of the 5-DOF plant: no keys besides ``model``."""
 
-    _, vp_true, record = vehicle_arrays(scenario)
-    act = scenario.actuator
-    pp = np.concatenate([vp_true, pack_actuator(act.tau_max, act.rate_max)])
+    model: Literal["5dof"] = "5dof"
+
+
+def check_scenario(scenario) -> None:
+    """Refuse a start with roll: the 5-DOF model has none.
+
+    Parameters
+    ----------
+    scenario : auvtrack.scenario.Scenario
+        The scenario being validated.
+
+    Raises
+    ------
+    ValueError
+        ``initial.phi: ...`` or ``initial.p: ...``.
+    """
+    from ..fields import format_value
+
+    for k in ("phi", "p"):
+        if getattr(scenario.initial, k) != 0.0:
+            raise ValueError(f"initial.{k}: roll exists only with plant.model = \"6dof\" "
+                             f"(got {format_value(getattr(scenario.initial, k))})")
+
+
+def setup(section: Section, ctx) -> CompiledPlant:
+    """Pack the true 5-DOF vehicle (the design vehicle with the uncertainty) and the input limits.
+
+    Parameters
+    ----------
+    section : Section
+        The ``[plant]`` section.
+    ctx : auvtrack.plant.registry.PlantContext
+        The true vehicle, the ``[actuator]`` limits, the initial state.
+
+    Returns
+    -------
+    CompiledPlant
+        Packed parameters and initial state.
+    """
+    act = ctx.actuator
+    pp = np.concatenate([ctx.vp_true, pack_actuator(act.tau_max, act.rate_max)])
     assert pp.size == PP_ACT + ACT_SIZE
-    x0 = np.array([*scenario.initial.eta, *scenario.initial.nu], dtype=np.float64)
-    return CompiledPlant(pp=pp, x0=x0, resolved={"model": NAME, "vehicle": record})
+    x0 = np.array([*ctx.eta0, *ctx.nu0], dtype=np.float64)
+    return CompiledPlant(pp=pp, x0=x0, resolved={"model": NAME, "vehicle": ctx.vehicle_record})

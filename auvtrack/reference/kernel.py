@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from ..engine.jit import njit, njit_noalloc
+from ..jit import njit, njit_noalloc
 
 FAMILY_SEGMENTS = 1
 H_FAMILY, H_LEN, H_NSEG, H_STRIDE = 0, 1, 2, 3

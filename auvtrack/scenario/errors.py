@@ -7,7 +7,6 @@ Validators in :mod:`auvtrack.scenario.schema` raise ``ValueError("field: text")`
 """
 from __future__ import annotations
 
-import math
 import re
 import types
 import typing
@@ -15,11 +14,12 @@ from typing import Any, Callable, Iterable
 
 from pydantic import BaseModel, ValidationError
 
+from ..fields import format_value, one_line
+
 __all__ = ["ScenarioError", "format_value", "one_line", "translate"]
 
 # "field: text" or "a.0.b: text" at the start of a validator message
 _FIELD_PREFIX = re.compile(r"^((?:[A-Za-z_]\w*|\d+)(?:\.(?:[A-Za-z_]\w*|\d+))*): (.+)$", re.S)
-_MAX_VALUE_CHARS = 48
 
 
 class ScenarioError(ValueError):
@@ -42,26 +42,6 @@ class ScenarioError(ValueError):
     def __init__(self, message: str, path: str = "") -> None:
         super().__init__(one_line(message))
         self.path = path
-
-
-def one_line(text: str) -> str:
-    """Collapse all whitespace (newlines included) of ``text`` to single spaces."""
-    return " ".join(str(text).split())
-
-
-def format_value(value: Any) -> str:
-    """Short TOML-like rendering of a user value for ``(got ...)``."""
-    if isinstance(value, bool):
-        s = "true" if value else "false"
-    elif isinstance(value, float) and not math.isfinite(value):
-        s = "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
-    elif isinstance(value, dict):
-        s = "a table {" + ", ".join(f"{k} = {format_value(v)}" for k, v in value.items()) + "}"
-    elif isinstance(value, (list, tuple)):
-        s = "[" + ", ".join(format_value(v) for v in value) + "]"
-    else:
-        s = repr(value)
-    return one_line(s if len(s) <= _MAX_VALUE_CHARS else s[: _MAX_VALUE_CHARS - 3] + "...")
 
 
 def _unwrap(annotation: Any) -> Any:
@@ -87,8 +67,12 @@ def _union_members(annotation: Any) -> list[type[BaseModel]]:
 
 
 def _kind_of(model: type[BaseModel]) -> str | None:
-    field = model.model_fields.get("kind")
-    return field.default if field is not None and isinstance(field.default, str) else None
+    """The tag of a discriminated union's member: its ``kind`` (controllers) or ``model`` (plants)."""
+    for tag in ("kind", "model"):
+        field = model.model_fields.get(tag)
+        if field is not None and isinstance(field.default, str):
+            return field.default
+    return None
 
 
 def _walk(root: type[BaseModel], loc: Iterable[Any]) -> tuple[list[str], Any]:

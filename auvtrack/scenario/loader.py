@@ -80,7 +80,7 @@ def _read_source(source: Source) -> tuple[str, dict[str, Any]]:
     if isinstance(source, Mapping):
         return "<dict>", copy.deepcopy(dict(source))
     if isinstance(source, (str, os.PathLike)):
-        from ..control.plugin import anchor_module  # a plug-in path is relative to its scenario file
+        from ..user_modules import anchor_module  # a plug-in path is relative to its scenario file
 
         return os.fspath(source), anchor_module(read_toml(source), Path(source).parent)
     raise ScenarioError(f"scenario source must be a TOML file path, a dict or a Scenario "

@@ -11,19 +11,21 @@ import math
 import typing
 from typing import Annotated, Any, Literal, Mapping, Union
 
-from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_validator,
+from pydantic import (BaseModel, ConfigDict, Field, field_validator,
                       model_validator)
 
 from ..control import CONTROLLERS
-from ..control.gain_presets import FXTNTSMCParams, available_gain_presets, get_gain_preset
+from ..control import spec_for as controller_spec_for
+from ..control import fxtntsmc
+from ..control.gain_presets import available_gain_presets, get_gain_preset
 from ..environment.current import MAX_SAMPLES as MAX_CURRENT_SAMPLES
 from ..vehicle.presets import available, get_preset, is_reduced
-from ..vehicle.truth_presets import available6, load_preset6
 from ..vehicle.reduction import U0_MAX, U0_MIN, default_u0
-from ..plant.sixdof.truth import actuator_values
+from ..plant import PLANTS, five_dof
+from ..plant import spec_for as plant_spec_for
+from ..fields import (Bool, Coefficient, Coefficient5, Fraction, Int, Mass5, NonNeg, NonNeg5, Num, Open01, Pos, Pos3,
+                      PosOrInf3, Range2, Str, Vec5, inf_words)
 from ..reference import build_reference
-
-DEFAULT_PLANT_PRESET = "remus100_prestero"
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
 from .names import check_name
@@ -33,27 +35,6 @@ __all__ = [
     "UncertaintySection", "InitialSection", "EnvelopeSection", "EstimatorSection",
     "MetricsSection", "OutputSection", "ActuatorSection", "SensorSection", "LimitsSection", "PlantSection",
 ]
-
-# --- strict scalar types ------------------------------------------------------------------------
-Num = Annotated[float, Strict(), AllowInfNan(False)]  # finite; int accepted, str/bool refused
-Pos = Annotated[Num, Field(gt=0)]
-NonNeg = Annotated[Num, Field(ge=0)]
-Int = Annotated[int, Strict()]
-Bool = Annotated[bool, Strict()]
-Str = Annotated[str, Strict()]
-Vec3 = tuple[Num, Num, Num]
-Vec5 = tuple[Num, Num, Num, Num, Num]
-Pos3 = tuple[Pos, Pos, Pos]
-Pos5 = tuple[Pos, Pos, Pos, Pos, Pos]
-NonNeg5 = tuple[NonNeg, NonNeg, NonNeg, NonNeg, NonNeg]
-Range2 = tuple[Num, Num]
-Fraction = Annotated[Num, Field(ge=-0.9, le=2.0)]
-# physically meaningful vehicle numbers (a 1 kg model to a 10 000 t submarine; docs/scenarios.md)
-Mass = Annotated[Num, Field(ge=1e-3, le=1e7)]
-Coefficient = Annotated[Num, Field(ge=0, le=1e7)]
-Mass5 = tuple[Mass, Mass, Mass, Mass, Mass]
-Coefficient5 = tuple[Coefficient, Coefficient, Coefficient, Coefficient, Coefficient]
-Open01 = Annotated[Num, Field(gt=0, lt=1)]
 
 # Controllers selectable by ``[controller] kind``: the parameter model of every registered controller.
 CONTROLLER_MODELS: tuple[type[BaseModel], ...] = tuple(spec.params for spec in CONTROLLERS.values())
@@ -107,7 +88,7 @@ class SimSection(_Section):
     log_dt: Pos = Field(0.01, description="logging interval, s (integer multiple of dt, divides duration)")
     control_rate: NonNeg = Field(0.0, description="Hz; 0 = continuous (every RK4 stage)")
     theta_limit: Annotated[Num, Field(gt=0, lt=90)] = Field(85.0, description="|pitch| stop, deg")
-    phi_limit: Annotated[Num, Field(gt=0, le=180)] = Field(  # issue 11: 6-DOF truth plants
+    phi_limit: Annotated[Num, Field(gt=0, le=180)] = Field(  # 6-DOF truth plants
         85.0, description="|roll| stop, deg (6-DOF plants; the 5-DOF plant has no roll)")
     state_limit: Pos = Field(1e6, description="abs bound on every state before divergence")
     integrator: Literal["rk4"] = "rk4"
@@ -173,11 +154,9 @@ class VehicleSection(_Section):
     wgml: Coefficient | None = Field(None, description="rho g nabla GM_L, N m")
     l: Annotated[Num, Field(gt=0, le=10)] | None = Field(  # noqa: E741 - paper's symbol
         None, description="virtual-point offset ell, m (ell = 0 makes J3 singular)")
-    # --- issue 11: linearisation speed of a reduced preset (begin) -------------------------------
     u0: Annotated[Num, Field(ge=U0_MIN, le=U0_MAX)] | None = Field(
         None, description="linearisation speed of a reduced preset (remus100), m/s; default: the "
                           "mean speed of the scenario's reference")
-    # --- issue 11 (end) --------------------------------------------------------------------------
 
     @model_validator(mode="before")
     @classmethod
@@ -190,13 +169,11 @@ class VehicleSection(_Section):
         names = available()
         if name not in names:
             raise ValueError(f"preset: unknown preset (allowed: {', '.join(names)}) (got {name!r})")
-        # --- issue 11: a reduced preset is computed at vehicle.u0 (begin) ---
         u0 = data.get("u0")
         if u0 is not None and not is_reduced(name):
             raise ValueError(f"u0: only a reduced preset ({', '.join(n for n in names if is_reduced(n))}) "
                              f"has a linearisation speed; {name!r} has none (got {format_value(u0)})")
         pre = get_preset(name, u0=u0 if isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX else None)
-        # --- issue 11 (end) ---
         out = dict(data)
         for key in _VEHICLE_FIELDS:
             if out.get(key) is None:
@@ -213,7 +190,7 @@ class VehicleSection(_Section):
             per number ``{"unit", "source", "origin"}`` with ``origin`` ``"preset"`` or
             ``"scenario"`` (an override differing from the preset value).
         """
-        pre = get_preset(self.preset, u0=self.u0)  # issue 11: reduced presets at u0
+        pre = get_preset(self.preset, u0=self.u0)  # a reduced preset at u0
         out: dict[str, Any] = {"preset": pre.name, "description": pre.description}
         if pre.u0 is not None:
             out["u0"] = pre.u0
@@ -265,7 +242,7 @@ class InitialSection(_Section):
 
     eta: Vec5 = Field((0.0, 0.5, 0.0, 0.0, 0.0), description="m, m, m, rad, rad")
     nu: Vec5 = Field((0.0, 0.0, 0.0, 0.0, 0.0), description="m/s, m/s, m/s, rad/s, rad/s")
-    # issue 11: roll and roll rate of a 6-DOF truth plant (0 for the 5-DOF plant)
+    # roll and roll rate of a 6-DOF truth plant (0 for the 5-DOF plant)
     phi: Annotated[Num, Field(gt=-math.pi / 2, lt=math.pi / 2)] = Field(0.0, description="roll, rad (6-DOF plants)")
     p: Annotated[Num, Field(ge=-10.0, le=10.0)] = Field(0.0, description="roll rate, rad/s (6-DOF plants)")
 
@@ -280,17 +257,6 @@ class InitialSection(_Section):
         return _check_items(nu, NU0_BOUNDS)
 
 
-def _inf_words(value: Any) -> Any:
-    """Accept ``"inf"`` (as written by :meth:`Scenario.to_dict`) for an unlimited actuator."""
-    if isinstance(value, (list, tuple)):
-        return [math.inf if isinstance(x, str) and x.strip().lower() in ("inf", "+inf") else x for x in value]
-    return value
-
-
-PosOrInf = Annotated[float, Strict(), Field(gt=0)]  # +inf allowed (no limit); NaN refused by gt
-PosOrInf3 = tuple[PosOrInf, PosOrInf, PosOrInf]
-
-
 class ActuatorSection(_Section):
     """``[actuator]``: input limits; ``inf`` = ideal actuator (the paper's assumption)."""
 
@@ -301,7 +267,7 @@ class ActuatorSection(_Section):
     @field_validator("tau_max", "rate_max", mode="before")
     @classmethod
     def _words(cls, v: Any) -> Any:
-        return _inf_words(_broadcast3(v))
+        return inf_words(_broadcast3(v))
 
 
 class SensorSection(_Section):
@@ -311,67 +277,9 @@ class SensorSection(_Section):
     sigma_nu: NonNeg5 = Field((0.0,) * 5, description="std of u, v, w (m/s), q, r (rad/s)")
 
 
-# --- issue 11: the truth plant (begin) ---------------------------------------------------------
-PLANT_ACTUATOR_KEYS = ("delta_max", "n_max", "T_delta", "T_n", "delta_rate_max", "n_rate_max")
-
-
-class PlantSection(_Section):
-    """``[plant]``: the truth plant the controller flies (docs/vehicles.md).
-
-    ``model = "5dof"``: the paper's model with the ``[vehicle]`` numbers and ``[uncertainty]``;
-    ``model = "6dof"``: a 6-DOF truth model ``preset`` with fins, propeller and actuator states,
-    which the controller does not know (it keeps ``[vehicle]`` as its design model).  The
-    actuator keys override the preset's (6-DOF only).
-    """
-
-    model: Literal["5dof", "6dof"] = Field("5dof", description="'5dof' (paper eq. 1) or '6dof' (a truth preset)")
-    preset: Str | None = Field(None, description="6-DOF preset: remus100_prestero (default) or remus100_fossen")
-    delta_max: Annotated[Num, Field(gt=0, le=math.pi / 2)] | None = Field(None, description="fin angle limit, rad")
-    n_max: Pos | None = Field(None, description="propeller speed limit, rpm")
-    T_delta: Pos | None = Field(None, description="fin time constant, s")
-    T_n: Pos | None = Field(None, description="propeller time constant, s")
-    delta_rate_max: PosOrInf | None = Field(None, description="fin rate limit, rad/s (inf = none)")
-    n_rate_max: PosOrInf | None = Field(None, description="propeller rate limit, rpm/s (inf = none)")
-
-    @field_validator("delta_rate_max", "n_rate_max", mode="before")
-    @classmethod
-    def _word(cls, v: Any) -> Any:
-        return _inf_words([v])[0] if isinstance(v, str) else v
-
-    @model_validator(mode="before")
-    @classmethod
-    def _default_preset(cls, data: Any) -> Any:
-        if isinstance(data, Mapping) and data.get("model") == "6dof" and data.get("preset") is None:
-            return {**data, "preset": DEFAULT_PLANT_PRESET}
-        return data
-
-    @model_validator(mode="after")
-    def _preset(self) -> "PlantSection":
-        if self.model == "5dof":
-            given = [k for k in ("preset", *PLANT_ACTUATOR_KEYS) if getattr(self, k) is not None]
-            if given:
-                raise ValueError(f"{given[0]}: only for plant.model = \"6dof\" "
-                                 f"(got {format_value(getattr(self, given[0]))} with model \"5dof\")")
-            return self
-        names = available6()
-        if self.preset not in names:
-            raise ValueError(f"preset: unknown 6-DOF preset (allowed: {', '.join(names)}) (got {self.preset!r})")
-        try:
-            actuator_values(load_preset6(self.preset), self.actuator_overrides())
-        except ValueError as exc:  # "plant.<key>: ..." -> "<key>: ..."
-            raise ValueError(str(exc).removeprefix("plant.")) from None
-        return self
-
-    def actuator_overrides(self) -> dict[str, float]:
-        """The actuator keys given (6-DOF): name -> value."""
-        return {k: getattr(self, k) for k in PLANT_ACTUATOR_KEYS if getattr(self, k) is not None}
-
-    def actuator_limits(self) -> dict[str, float] | None:
-        """Effective actuator numbers of a 6-DOF plant (preset with overrides); None for 5dof."""
-        if self.model != "6dof":
-            return None
-        return actuator_values(load_preset6(self.preset), self.actuator_overrides())
-# --- issue 11 (end) ------------------------------------------------------------------------------
+# Plants selectable by ``[plant] model``: the section model of every registered plant.
+PLANT_MODELS: tuple[type[BaseModel], ...] = tuple(spec.section for spec in PLANTS.values())
+PlantSection = Annotated[Union[PLANT_MODELS], Field(discriminator="model")]  # type: ignore[valid-type]
 
 
 class EnvelopeSection(_Section):
@@ -547,7 +455,7 @@ class Scenario(BaseModel):
         The TOML sections of the same names.
     reference : dict
         Resolved reference spec (``kind`` and every field of that kind).
-    controller : FXTNTSMCParams, FTSMCParams or OpenLoopParams
+    controller : pydantic model
         Controller parameters, selected by ``kind``.
     disturbance : list of dict
         Resolved disturbance specs (summed); empty for none.
@@ -563,7 +471,7 @@ class Scenario(BaseModel):
     uncertainty: UncertaintySection = Field(default_factory=UncertaintySection)
     reference: dict[str, Any] = Field(default_factory=lambda: {"kind": "helix"}, validate_default=True)
     initial: InitialSection = Field(default_factory=InitialSection)
-    controller: ControllerParams = Field(default_factory=FXTNTSMCParams)
+    controller: ControllerParams = Field(default_factory=fxtntsmc.Params)
     envelope: EnvelopeSection = Field(default_factory=EnvelopeSection)
     estimator: EstimatorSection = Field(default_factory=EstimatorSection)
     disturbance: list[dict[str, Any]] = Field(default_factory=lambda: [{"kind": "paper"}],
@@ -573,9 +481,8 @@ class Scenario(BaseModel):
     actuator: ActuatorSection = Field(default_factory=ActuatorSection)
     sensor: SensorSection = Field(default_factory=SensorSection)
     limits: LimitsSection = Field(default_factory=LimitsSection)
-    plant: PlantSection = Field(default_factory=PlantSection)  # issue 11
+    plant: PlantSection = Field(default_factory=five_dof.Section)
 
-    # --- issue 11: a reduced vehicle preset is linearised at the reference's speed (begin) -----
     @model_validator(mode="before")
     @classmethod
     def _reduction_speed(cls, data: Any) -> Any:
@@ -595,8 +502,6 @@ class Scenario(BaseModel):
         except (ValueError, TypeError, AttributeError):
             return data
         return {**data, "vehicle": {**veh, "u0": default_u0(ref, duration)}}
-    # --- issue 11 (end) ---------------------------------------------------------------------------
-
     @field_validator("name")
     @classmethod
     def _name(cls, v: str) -> str:
@@ -634,39 +539,19 @@ class Scenario(BaseModel):
                 _check_numbers(model, v)
         return v
 
-    # --- issue 11: options that exist for one plant model only (begin) --------------------------
     @model_validator(mode="after")
-    def _plant_options(self) -> "Scenario":
-        """5-DOF-only options with a 6-DOF truth, and roll initial values with the 5-DOF plant."""
-        if self.plant.model == "6dof":
-            default = UncertaintySection()
-            for k in ("C", "D", "M", "G"):
-                if getattr(self.uncertainty, k) != getattr(default, k):
-                    raise ValueError(f"uncertainty.{k}: scales the 5-DOF plant only; with plant.model = \"6dof\" "
-                                     f"the truth is the preset {self.plant.preset!r} (got {format_value(getattr(self.uncertainty, k))})")
-            for k in ("tau_max", "rate_max"):
-                v = getattr(self.actuator, k)
-                if any(math.isfinite(x) for x in v):
-                    raise ValueError(f"actuator.{k}: limits the 5-DOF input only; with plant.model = \"6dof\" the fins "
-                                     f"and propeller limit it (plant.delta_max, plant.n_max, ...) (got {format_value(v)})")
-            if self.controller.kind == "open_loop_actuators":
-                lim = self.plant.actuator_limits()
-                for k, cap, key in (("delta_r", lim["delta_max"], "delta_max"), ("delta_s", lim["delta_max"], "delta_max"),
-                                    ("rpm", lim["n_max"], "n_max")):
-                    v = getattr(self.controller, k)
-                    if abs(v) > cap:
-                        raise ValueError(f"controller.{k}: beyond the actuator limit plant.{key} = {cap:.6g} "
-                                         f"(got {format_value(v)})")
-        else:
-            if self.controller.kind == "open_loop_actuators":
-                raise ValueError("controller.kind: open_loop_actuators commands fins and propeller; it needs "
-                                 "plant.model = \"6dof\" (got 'open_loop_actuators' with plant.model \"5dof\")")
-            for k in ("phi", "p"):
-                if getattr(self.initial, k) != 0.0:
-                    raise ValueError(f"initial.{k}: roll exists only with plant.model = \"6dof\" "
-                                     f"(got {format_value(getattr(self.initial, k))})")
+    def _plant_and_controller(self) -> "Scenario":
+        """The controller can fly the plant (what it commands), and the plant's own cross-checks."""
+        plant, ctrl = plant_spec_for(self.plant), controller_spec_for(self.controller)
+        if not ctrl.runs_on(plant):
+            which = ("commands " + ("the actuators" if ctrl.commands == "actuators" else "tau")
+                     if ctrl.commands not in plant.accepts else f"runs on plant.model in {list(ctrl.plants or ())}")
+            raise ValueError(f"controller.kind: {self.controller.kind} {which}; plant.model {self.plant.model!r} "
+                             f"accepts {' or '.join(plant.accepts)} (choose another plant.model or controller)")
+        if plant.check_scenario is not None:
+            plant.check_scenario(self)
         return self
-    # --- issue 11 (end) ---------------------------------------------------------------------------
+
 
     @model_validator(mode="after")
     def _start_inside_limits(self) -> "Scenario":
@@ -698,7 +583,7 @@ class Scenario(BaseModel):
         ``load_scenario(s.to_dict()) == s``.
         """
         out = jsonable(self.model_dump(mode="python"))
-        if out["vehicle"].get("u0") is None:  # issue 11: only a reduced preset has a u0
+        if out["vehicle"].get("u0") is None:  # only a reduced preset has a u0
             out["vehicle"].pop("u0", None)
-        out["plant"] = {k: v for k, v in out["plant"].items() if v is not None}  # issue 11: 6-DOF-only keys
+        out["plant"] = {k: v for k, v in out["plant"].items() if v is not None}  # unset overrides
         return out

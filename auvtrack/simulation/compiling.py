@@ -10,39 +10,48 @@ from typing import Sequence
 
 from ..engine import kernels
 
-__all__ = ["builtin_controllers", "builtin_pairs", "SIXDOF_ONLY", "kernel_keys", "compile_first", "ensure_compiled",
+__all__ = ["builtin_controllers", "builtin_pairs", "kernel_keys", "compile_first", "ensure_compiled",
            "warmup"]
 
 
-def builtin_controllers() -> tuple[str, ...]:
-    """Kinds of the built-in controllers (``auvtrack.control.BUILTIN``; the plug-in loader is not one)."""
-    from ..control import BUILTIN_NAMES
+def builtin_controllers(plant: str = "5dof") -> tuple[str, ...]:
+    """Kinds of the built-in controllers that run on ``plant`` (their capabilities), in registry order.
 
-    # open_loop_actuators drives a 6-DOF plant's fins and propeller (issue 11): not on Section 4
-    return tuple(n for n in BUILTIN_NAMES if n != "open_loop_actuators")
+    Parameters
+    ----------
+    plant : str, optional
+        A registered plant model.
 
+    Returns
+    -------
+    tuple of str
+        The kinds.
+    """
+    from ..control import BUILTIN_NAMES, CONTROLLERS
+    from ..plant import PLANTS
 
-SIXDOF_ONLY: tuple[str, ...] = ("open_loop_actuators",)
-"""Built-in controllers that only run on a 6-DOF plant (fin and propeller commands)."""
+    return tuple(n for n in BUILTIN_NAMES if CONTROLLERS[n].runs_on(PLANTS[plant]))
 
 
 def builtin_pairs(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = ()) -> list[tuple[str, str]]:
-    """(controller, plant) pairs a run can use: every built-in controller on every plant it runs on.
+    """(controller, plant) pairs a run can use: every controller on every plant it runs on.
 
     Parameters
     ----------
     controllers, plants : tuple of str, optional
-        Registered names (default: every built-in controller, :data:`SIXDOF_ONLY` included, and every plant).
+        Registered names (default: every built-in controller and every built-in plant).
 
     Returns
     -------
     list of (str, str)
-        The pairs, controllers in registry order; a :data:`SIXDOF_ONLY` controller only with ``"6dof"``.
+        The pairs, controllers in registry order, each with the plants its capabilities allow.
     """
+    from ..control import BUILTIN_NAMES, CONTROLLERS
+    from ..plant import BUILTIN_NAMES as PLANT_NAMES
     from ..plant import PLANTS
 
-    cs = controllers or builtin_controllers() + SIXDOF_ONLY
-    return [(c, p) for c in cs for p in (plants or tuple(PLANTS)) if c not in SIXDOF_ONLY or p == "6dof"]
+    return [(c, p) for c in (controllers or BUILTIN_NAMES) for p in (plants or PLANT_NAMES)
+            if CONTROLLERS[c].runs_on(PLANTS[p])]
 
 
 def ensure_compiled(preps: Sequence, *, progress: bool = False) -> None:
@@ -59,9 +68,7 @@ def ensure_compiled(preps: Sequence, *, progress: bool = False) -> None:
 
 
 def kernel_keys(pairs: Sequence[tuple[str, str]]) -> list[kernels.KernelKey]:
-    """The kernels of (controller kind, plant model) pairs: one per plant module.
-
-    A plant with presets in their own modules (``"6dof"``) gives one kernel per preset.
+    """The kernels of (controller kind, plant model) pairs, one each.
 
     Parameters
     ----------
@@ -76,8 +83,7 @@ def kernel_keys(pairs: Sequence[tuple[str, str]]) -> list[kernels.KernelKey]:
     from ..control import CONTROLLERS
     from ..plant import PLANTS
 
-    return [kernels.KernelKey(CONTROLLERS[c].module, module, f"{c} on {label}")
-            for c, p in pairs for label, module in PLANTS[p].kernel_modules.items()]
+    return [kernels.KernelKey(CONTROLLERS[c].module, PLANTS[p].module, f"{c} on {p}") for c, p in pairs]
 
 
 def compile_first(pairs: Sequence[tuple[str, str]], *, progress: bool = False) -> list[kernels.KernelKey]:

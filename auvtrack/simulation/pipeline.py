@@ -7,8 +7,6 @@ controller's set-up: everything becomes packed float64 arrays, bundled as the en
 """
 from __future__ import annotations
 
-import importlib
-
 import math
 import threading
 import time
@@ -19,28 +17,30 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .. import __version__
-from ..control import get as get_controller
+from ..control import spec_for as controller_spec_for
 from ..control.contract import CONTROLLER_STATUS
+from ..control.registry import PlantView, SetupContext
 from ..environment import build_disturbance, pack_disturbances
 from ..environment.sensors import noise_table
-from ..plant import get as get_plant
+from ..plant import PlantContext
+from ..plant import spec_for as plant_spec_for
 from ..vehicle.kinematics import attitude, virtual_point
-from ..vehicle.params import ELL
+from ..vehicle.params import VP
 from ..vehicle.presets import vehicle_arrays  # noqa: F401  (re-exported: studies use it from here)
 from ..reference import build_reference
 from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
 from ..scenario.plan import plan_run
+from ..user_modules import load_module
 from ..engine import loop as engine
 from ..engine import kernels
+from ..channels import BASE_CHANNELS, LOG_ROW, channel_names
 from ..engine.loop import ControllerBundle, EnvironmentBundle, Outputs, PlantBundle, Settings
-from .metrics import METRICS_SIZE, metrics_finalize, metrics_init
+from ..plant.contract import SF
+from ..metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from .result import Result
 
-BASE_CHANNELS = ("t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r",
-                 "tau_u", "tau_q", "tau_r", "xd", "yd", "zd", "ex", "ey", "ez")
-CHI_CHANNELS = ("chi_x", "chi_y", "chi_z")
-STATE_NAMES = BASE_CHANNELS[1:11]
+STATE_NAMES = BASE_CHANNELS[LOG_ROW.eta:LOG_ROW.tau]  # eta and nu
 
 
 class SimulationInterrupted(KeyboardInterrupt):
@@ -55,37 +55,6 @@ class SimulationInterrupted(KeyboardInterrupt):
     def __init__(self, result: "Result") -> None:
         super().__init__("simulation interrupted")
         self.result = result
-
-
-@dataclass(frozen=True)
-class SetupContext:
-    """What a controller's ``setup`` may use besides the scenario.
-
-    Attributes
-    ----------
-    vp_nom : numpy.ndarray
-        Packed nominal vehicle (:mod:`auvtrack.vehicle.params`).
-    refm0 : numpy.ndarray
-        Reference at t = 0, rows eta_d, eta_d_dot, eta_d_ddot.
-    e0 : numpy.ndarray
-        Initial virtual-point error eta1(0) - eta_d(0) (m).
-    seed : int
-        Scenario seed.
-    actuator : object
-        The scenario's ``[actuator]`` section (``tau_max``, ``rate_max``), e.g. for anti-windup.
-    dt : float
-        RK4 step (s).
-    control_rate : float
-        Controller sampling rate (Hz; 0 = continuous).
-    """
-
-    vp_nom: np.ndarray
-    refm0: np.ndarray
-    e0: np.ndarray
-    seed: int
-    actuator: Any = None
-    dt: float = 0.001
-    control_rate: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -128,8 +97,8 @@ class Prepared:
     statuses: dict
 
     # short names for the most used arrays
-    si = property(lambda self: self.settings.si, doc="Integer settings (engine SI_*).")
-    sf = property(lambda self: self.settings.sf, doc="Float settings (engine SF_*).")
+    si = property(lambda self: self.settings.si, doc="Integer settings (layout :data:`auvtrack.engine.loop.SI`).")
+    sf = property(lambda self: self.settings.sf, doc="Float settings (layout :data:`auvtrack.plant.contract.SF`).")
     cp = property(lambda self: self.controller.cp, doc="Packed controller parameters.")
     vp_nom = property(lambda self: self.controller.vp, doc="Packed nominal 5-DOF vehicle.")
     pp = property(lambda self: self.plant.pp, doc="Packed true-plant parameters.")
@@ -138,7 +107,7 @@ class Prepared:
     @property
     def n_steps(self) -> int:
         """RK4 steps planned."""
-        return int(self.settings.si[engine.SI_NSTEPS])
+        return int(self.settings.si[engine.SI.n_steps])
 
     @property
     def n_state(self) -> int:
@@ -172,37 +141,41 @@ def prepare(scenario: Scenario) -> Prepared:
         (:class:`~auvtrack.scenario.ScenarioError`, :func:`auvtrack.scenario.plan.plan_run`).
     """
     sc = scenario
-    plant_spec = get_plant(sc.plant.model) if hasattr(sc, "plant") else get_plant("5dof")
-    cpl = plant_spec.setup(sc)
-    vp_nom, _, _ = vehicle_arrays(sc)
+    cspec = controller_spec_for(sc.controller)
+    plant_spec = plant_spec_for(sc.plant)
+    vp_nom, vp_true, record = vehicle_arrays(sc)
+    eta0, nu0 = tuple(float(v) for v in sc.initial.eta), tuple(float(v) for v in sc.initial.nu)
+    pctx = PlantContext(eta0=eta0, nu0=nu0, phi0=float(sc.initial.phi), p0=float(sc.initial.p), vp_true=vp_true,
+                        vehicle_record=record, design_preset=sc.vehicle.preset, actuator=sc.actuator,
+                        commands=cspec.commands, seed=sc.seed)
+    cpl = plant_spec.setup(sc.plant, pctx)
+    plant_module = cpl.module or plant_spec.module
     ref = build_reference(dict(sc.reference))
     ref_p = ref.pack()
-    eta0 = np.array(sc.initial.eta, dtype=float)
     p0, v0, a0 = ref.evaluate(0.0)
     refm0 = np.vstack([p0, v0, a0])
-    p1 = np.array(virtual_point(tuple(eta0), attitude(eta0[3], eta0[4]), vp_nom[ELL]))
-    ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed, actuator=sc.actuator,
+    p1 = np.array(virtual_point(eta0, attitude(eta0[3], eta0[4]), vp_nom[VP.ell]))
+    view = PlantView(plant_module, plant_spec.state, plant_spec.command, _c(cpl.x0), _c(cpl.pp))
+    ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed, eta0=eta0, nu0=nu0,
+                       actuator=sc.actuator, plant=view, sections={k: getattr(sc, k) for k in cspec.sections},
                        dt=sc.sim.dt, control_rate=sc.sim.control_rate)
-    cspec = get_controller(sc.controller.kind)
-    cc = cspec.setup(sc, ctx)
-    channels = BASE_CHANNELS + tuple(cc.aux_names) + CHI_CHANNELS + tuple(cpl.log_names)
+    cc = cspec.setup(sc.controller, ctx)
+    channels = channel_names(cc.aux_names, cpl.log_names)
     plan = plan_run(sc, len(channels))  # every size checked against [limits] before any allocation
     tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     dt = sc.sim.dt
     n_steps, log_every, ctrl_every = plan.n_steps, plan.log_every, plan.control_every
     naux = len(cc.aux_names)
-    si = np.array([n_steps, log_every, ctrl_every, naux], dtype=np.int64)
+    si = engine.SI.pack(np.int64, n_steps=n_steps, log_every=log_every, ctrl_every=ctrl_every, n_aux=naux)
     t0, t1 = sc.metrics.window
     phi_limit = getattr(sc.sim, "phi_limit", 90.0)
-    sf = np.array([dt, math.radians(sc.sim.theta_limit), sc.sim.state_limit, t0,
-                   t1 if math.isfinite(t1) else 1e300, math.radians(phi_limit)])
-    assert si.size == engine.SI_SIZE and sf.size == engine.SF_SIZE
+    sf = SF.pack(dt=dt, theta_lim=math.radians(sc.sim.theta_limit), state_lim=sc.sim.state_limit, win_t0=t0,
+                 win_t1=t1 if math.isfinite(t1) else 1e300, phi_lim=math.radians(phi_limit))
     sigma = (*sc.sensor.sigma_eta, *sc.sensor.sigma_nu)
     if ctrl_every == 0 and any(sigma):  # the schema refuses this too: never drop noise silently
         raise ValueError("sensor: noise needs sim.control_rate > 0")
     noise = noise_table(sc.seed, plan.control_samples if ctrl_every else 1, sigma)
-    key = kernels.KernelKey(cc.law or cspec.module, cpl.module or plant_spec.module,
-                            f"{cspec.name} on {plant_spec.name}")
+    key = kernels.KernelKey(cc.law or cspec.module, plant_module, f"{cspec.name} on {plant_spec.name}")
     return Prepared(
         scenario=sc, key=key,
         plant=PlantBundle(_c(cpl.pp), _c(cpl.x0)),
@@ -211,7 +184,7 @@ def prepare(scenario: Scenario) -> Prepared:
         ref_p=_c(ref_p), settings=Settings(si, sf),
         n_rows=plan.log_rows,
         channels=channels,
-        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[ELL])] if n),
+        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[VP.ell])] if n),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": cc.resolved},
         statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
@@ -367,7 +340,7 @@ def failure_record(cause: int, t: float, fail_state: np.ndarray, prep: Prepared)
 def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
     nxp = prep.plant.x0.size
     # the 5-DOF names label the plant's pose (a 6-DOF state has roll at index 3)
-    pose = importlib.import_module(prep.key.plant).pose
+    pose = load_module(prep.key.plant).pose
     eta, nu = pose(np.ascontiguousarray(state[:nxp], dtype=np.float64))
     st: dict[str, Any] = {n: float(v) for n, v in zip(STATE_NAMES, (*eta, *nu))}
     if nxp > len(STATE_NAMES):

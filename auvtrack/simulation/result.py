@@ -23,11 +23,7 @@ from typing import Any, BinaryIO, Iterator, Mapping
 import numpy as np
 
 from .._atomic import FolderError, make_temp_folder, open_exclusive, publish_folder, publish_new_folder
-from .channels import current_name, legacy_columns, upgrade_names
-
-BASE_CHANNELS: tuple[str, ...] = ("t", "x", "y", "z", "theta", "psi", "u", "v", "w", "q", "r",
-                                  "tau_u", "tau_q", "tau_r", "xd", "yd", "zd", "ex", "ey", "ez")
-"""Channels every result starts with, in this order (SI units: s, m, rad, m/s, rad/s, N, N m)."""
+from ..channels import BASE_CHANNELS
 
 STATUSES = ("ok", "failed", "interrupted")
 FAILURE_KEYS = ("time", "cause", "detail", "state")
@@ -277,7 +273,7 @@ class Result:
     failure : dict or None
         ``None`` for an ``ok`` run, else ``{"time", "cause", "detail", "state"}``.
     metrics : mapping of str to float
-        Named metrics (:data:`auvtrack.simulation.metrics.METRIC_NAMES`); ``None`` is read as NaN.
+        Named metrics (:data:`auvtrack.metrics.METRIC_NAMES`); ``None`` is read as NaN.
     meta : dict, optional
         Anything else worth recording (wall time, notes...).
     version : str, optional
@@ -372,23 +368,15 @@ class Result:
         return float(t[-1] - t[0]) if t.size > 1 else 0.0
 
     def __getitem__(self, name: str) -> np.ndarray:
-        """Return channel ``name`` (read-only array); an old channel name warns and still works."""
+        """Return channel ``name`` (read-only array)."""
         try:
             return self._ch[name]
         except KeyError:
-            new = current_name(name, self._ch, self._kind())
-            if new is not None:
-                return self._ch[new]
             raise KeyError(f"no channel {name!r}; available: {', '.join(self._ch)}") from None
 
     def __contains__(self, name: object) -> bool:
-        """Whether a channel called ``name`` exists (old channel names included, see ``channels``)."""
-        return name in self._ch or (isinstance(name, str) and
-                                    current_name(name, self._ch, self._kind(), warn=False) is not None)
-
-    def _kind(self) -> str | None:
-        ctrl = self.scenario.get("controller")
-        return ctrl.get("kind") if isinstance(ctrl, Mapping) else None
+        """Whether a channel called ``name`` exists."""
+        return name in self._ch
 
     def __iter__(self) -> Iterator[str]:
         """Iterate over channel names."""
@@ -416,27 +404,17 @@ class Result:
         return f"Result({', '.join(parts)})"
 
     # ---- conversion
-    def to_pandas(self, legacy_names: bool = True):
+    def to_pandas(self):
         """Return the channels as a :class:`pandas.DataFrame`.
-
-        Parameters
-        ----------
-        legacy_names : bool, optional
-            Also add the renamed channels under their old names (``S_x``, ``z_x`` of the FXTNTSMC,
-            ``s_x`` of the FTSMC), after every channel.  Deprecated: these columns disappear in
-            the next release (:mod:`auvtrack.simulation.channels`); pass ``False`` to drop them now.
 
         Returns
         -------
         pandas.DataFrame
-            One column per channel, in order (``t`` first), one row per sample, then the old
-            names, if any.
+            One column per channel, in order (``t`` first), one row per sample.
         """
         import pandas as pd
 
         cols = {k: np.array(v) for k, v in self._ch.items()}
-        if legacy_names:
-            cols.update({old: np.array(self._ch[new]) for old, new in legacy_columns(self._ch, self._kind()).items()})
         return pd.DataFrame(cols, columns=list(cols))
 
     def plot(self, kind: str = "overview", **kw: Any):
@@ -619,8 +597,7 @@ class Result:
         lines = (folder / CSV_NAME).read_text(encoding="utf-8").splitlines()
         if not lines:
             raise ValueError(f"{folder / CSV_NAME} is empty")
-        ctrl = (doc.get("scenario") or {}).get("controller")
-        names = upgrade_names(lines[0].split(","), ctrl.get("kind") if isinstance(ctrl, Mapping) else None)
+        names = lines[0].split(",")
         if len(lines) > 1:
             data = np.loadtxt(lines[1:], delimiter=",", dtype=np.float64, ndmin=2)
         else:

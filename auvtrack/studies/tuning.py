@@ -34,7 +34,7 @@ import numpy as np
 from scipy.optimize import differential_evolution
 
 from ..control import get as get_controller
-from ..control.gain_presets import FXTNTSMCParams
+from ..control import fxtntsmc
 from ..control.fxtntsmc.theory import check_theorem1
 from ..scenario import load_scenario
 from ..simulation.compiling import compile_first
@@ -396,7 +396,7 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     cases = tuple(TRAIN_CASES[: budget.n_train] if cases is None else cases)
 
     def mean_cost(gains: dict[str, float]) -> float:
-        if kind == "fxtntsmc" and check_theorem1(FXTNTSMCParams(**gains)):
+        if kind == "fxtntsmc" and check_theorem1(fxtntsmc.Params(**gains)):
             return 3.0 * objective.penalty  # outside Theorem 1 (the box already excludes it)
         try:
             return float(np.mean([run_cost(c, kind, gains, budget.duration, budget.dt, objective)[0]

@@ -28,13 +28,13 @@ from __future__ import annotations
 
 import math
 
-from ..engine.jit import njit
-from ..engine.vecmath import sincos4
+from ..jit import njit
+from ..jit.vecmath import sincos4
 
 
 @njit
 def attitude(theta, psi):
-    """Return att = (cos theta, sin theta, cos psi, sin psi), within 4 ulp (:func:`auvtrack.engine.vecmath.sincos4`)."""
+    """Return att = (cos theta, sin theta, cos psi, sin psi), within 4 ulp (:func:`auvtrack.jit.vecmath.sincos4`)."""
     s, c = sincos4((theta, psi, 0.0, 0.0))
     return c[0], s[0], c[1], s[1]
 

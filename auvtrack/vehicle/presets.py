@@ -23,7 +23,7 @@ from importlib import resources
 
 import numpy as np
 
-from .params import CSCALE, D0, ELL, M0, VP_SIZE, WGML
+from .params import VP
 
 _FIELDS = ("m", "d", "wgml", "l")
 SHIPPED: tuple[str, ...] = ("paper", "remus100")
@@ -135,12 +135,12 @@ def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
 
 def pack_vehicle(m, d, wgml: float, l: float, c_scale: float = 1.0) -> np.ndarray:
     """Pack vehicle numbers into the ``vp`` layout of :mod:`auvtrack.vehicle.params`."""
-    vp = np.zeros(VP_SIZE)
-    vp[M0 : M0 + 5] = m
-    vp[D0 : D0 + 5] = d
-    vp[WGML] = wgml
-    vp[ELL] = l
-    vp[CSCALE] = c_scale
+    vp = np.zeros(VP.size)
+    vp[VP.m : VP.m + 5] = m
+    vp[VP.d : VP.d + 5] = d
+    vp[VP.wgml] = wgml
+    vp[VP.ell] = l
+    vp[VP.cscale] = c_scale
     return vp
 
 

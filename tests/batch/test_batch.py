@@ -9,7 +9,7 @@ import pytest
 from auvtrack.scenario import load_scenario
 from auvtrack.simulation.pipeline import prepare, run_prepared
 from auvtrack.batch.runner import RunSummary, iter_batch, run_batch, run_metrics
-from auvtrack.simulation.metrics import METRIC_NAMES
+from auvtrack.metrics import METRIC_NAMES
 from auvtrack.scenario import paper_scenario_path
 
 PAPER = paper_scenario_path()
@@ -145,10 +145,11 @@ def test_state_check_precedence(preps):
     """One-pass state check over plant and controller states: non-finite before pitch before state limit."""
     from auvtrack.engine import loop as engine
     from auvtrack.engine import kernels
+    from auvtrack.plant.contract import SF
 
     state_cause = kernels.kernel_module(preps[0].key).state_cause
-    sf = np.zeros(engine.SF_SIZE)
-    sf[engine.SF_THETA_LIM], sf[engine.SF_STATE_LIM] = 1.0, 10.0
+    sf = np.zeros(SF.size)
+    sf[SF.theta_lim], sf[SF.state_lim] = 1.0, 10.0
     xp, xc = np.zeros(10), np.zeros(2)
     assert state_cause(xp, xc, sf) == engine.CAUSE_NONE
     xp[3], xp[7] = 2.0, 50.0

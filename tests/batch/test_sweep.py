@@ -19,7 +19,7 @@ from distributed.diagnostics.plugin import WorkerPlugin
 from auvtrack.cli import main
 from auvtrack.scenario import load_scenario
 from auvtrack.simulation.pipeline import prepare, run_prepared
-from auvtrack.simulation.metrics import METRIC_NAMES
+from auvtrack.metrics import METRIC_NAMES
 from auvtrack.batch.sweep import chunk_path, read_results, run_sweep
 from auvtrack.batch.sweep_spec import StudyError, load_study
 from auvtrack.batch.sweep_worker import run_chunk

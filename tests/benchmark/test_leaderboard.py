@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from auvtrack.simulation.metrics import METRIC_NAMES
+from auvtrack.metrics import METRIC_NAMES
 from auvtrack.benchmark import leaderboard as lb
 from auvtrack.benchmark.suite import METRICS
 

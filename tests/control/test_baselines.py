@@ -26,7 +26,8 @@ from auvtrack.control import backstepping, ftsmc, pid, ppc, sta
 from auvtrack.control.tracking import error_state
 from auvtrack.vehicle.dynamics import nu_dot
 from auvtrack.vehicle.kinematics import attitude, eta_dot, j3, j4, virtual_point
-from auvtrack.vehicle.params import ELL
+from auvtrack.control.contract import UNLIMITED, LawArgs, LawOutputs, Measured
+from auvtrack.vehicle.params import VP as LAYOUT
 from auvtrack.vehicle.presets import get_preset, pack_vehicle
 from auvtrack.reference import build_reference
 from auvtrack.scenario import load_scenario, paper_scenario_path
@@ -34,7 +35,7 @@ from auvtrack.scenario import load_scenario, paper_scenario_path
 PAPER = str(paper_scenario_path())
 IDEAL = ["uncertainty.C=0", "uncertainty.D=0", "disturbance=[]"]  # nominal plant, chi = 0
 _PRE = get_preset("paper")
-VP = pack_vehicle(np.array(_PRE.m), np.array(_PRE.d), _PRE.wgml, _PRE.l, 1.0)
+VP_NOM = pack_vehicle(np.array(_PRE.m), np.array(_PRE.d), _PRE.wgml, _PRE.l, 1.0)
 WORK = np.zeros(512)
 
 
@@ -49,7 +50,7 @@ def _sim(kind, extra=(), **kw):
 def _e_dot(eta, nu, refv):
     """e_dot of eq. (14) from kinematics alone: J3 v1 + J4 - eta_d_dot."""
     att = attitude(eta[3], eta[4])
-    J = np.array(j3(att, VP[ELL]))
+    J = np.array(j3(att, VP_NOM[LAYOUT.ell]))
     return J @ np.array([nu[0], nu[3], nu[4]]) + np.array(j4(att, nu[1], nu[2])) - refv
 
 
@@ -57,7 +58,7 @@ def e_ddot_nominal(eta, nu, tau, refm, h=1e-5):
     """d/dt e_dot along the nominal dynamics with input ``tau``, by central differences (O(h^2))."""
     att = attitude(eta[3], eta[4])
     deta = np.array(eta_dot(att, nu))
-    dnu = np.array(nu_dot(att, nu, tuple(tau), (0.0,) * 5, VP))
+    dnu = np.array(nu_dot(att, nu, tuple(tau), (0.0,) * 5, VP_NOM))
     eta, nu = np.array(eta), np.array(nu)
     plus = _e_dot(eta + h * deta, nu + h * dnu, refm[1] + h * refm[2])
     minus = _e_dot(eta - h * deta, nu - h * dnu, refm[1] - h * refm[2])
@@ -74,15 +75,16 @@ def _state(seed):
 
 def _setup(mod, extra=(), e0=(0.0, 0.0, 0.0), tau_max=(math.inf,) * 3):
     sc = load_scenario(PAPER, [f"controller={{kind=\"{mod.NAME}\"}}", *extra])
-    ctx = SimpleNamespace(vp_nom=VP, refm0=np.zeros((3, 3)), e0=np.asarray(e0), seed=0, dt=sc.sim.dt,
+    ctx = SimpleNamespace(vp_nom=VP_NOM, refm0=np.zeros((3, 3)), e0=np.asarray(e0), seed=0, dt=sc.sim.dt,
                           control_rate=sc.sim.control_rate,
                           actuator=SimpleNamespace(tau_max=tau_max, rate_max=(math.inf,) * 3))
-    return mod.setup(sc, ctx)
+    return mod.setup(sc.controller, ctx)
 
 
 def _call(mod, cc, t, eta, nu, att, xc, refm):
     tau, dxc, aux = np.zeros(3), np.zeros(xc.size), np.zeros(len(cc.aux_names))
-    status = mod.control(t, eta, nu, att, xc, refm, VP, cc.cp, tau, dxc, aux, WORK)
+    args = LawArgs(np.ascontiguousarray(refm), np.zeros(0), cc.cp, VP_NOM, *UNLIMITED, (0.0, 0.0, 0.0), 0.0, WORK)
+    status = mod.control(t, Measured(eta, nu, att), xc, args, LawOutputs(tau, dxc, aux))
     return status, tau, dxc, aux
 
 
@@ -99,7 +101,7 @@ def test_pid_commands_its_design_law_at_any_state(seed):
     cc = _setup(pid, ["controller.kp=2.5", "controller.ki=0.7", "controller.kd=1.9"])
     xc = rng.normal(0.0, 1.0, 3)
     status, tau, dxc, aux = _call(pid, cc, t, eta, nu, att, xc, refm)
-    e, ed, _ = (np.array(v) for v in error_state(eta, att, nu, refm, VP))
+    e, ed, _ = (np.array(v) for v in error_state(eta, att, nu, refm, VP_NOM))
     assert status == 0
     _close(e_ddot_nominal(eta, nu, tau, refm), -2.5 * e - 1.9 * ed - 0.7 * xc)
     _close(dxc, e, 1e-14)
@@ -115,7 +117,7 @@ def test_pid_back_calculation_under_saturation(seed):
     cc = _setup(pid, ["controller.kaw=0.8"], tau_max=tau_max)
     xc = rng.normal(0.0, 1.0, 3)
     _, tau, dxc, _ = _call(pid, cc, t, eta, nu, att, xc, refm)
-    e = np.array(error_state(eta, att, nu, refm, VP)[0])
+    e = np.array(error_state(eta, att, nu, refm, VP_NOM)[0])
     lost = np.clip(tau, -np.array(tau_max), tau_max) - tau
     da = e_ddot_nominal(eta, nu, tau + lost, refm) - e_ddot_nominal(eta, nu, tau, refm)
     _close(dxc, e - 0.8 / 1.0 * da, 1e-6)
@@ -131,7 +133,7 @@ def test_backstepping_commands_its_design_law_at_any_state(seed, adaptive):
     cc = _setup(backstepping, extra)
     bh = rng.normal(0.0, 0.5, 3)
     status, tau, dxc, aux = _call(backstepping, cc, t, eta, nu, att, bh, refm)
-    e, ed, _ = (np.array(v) for v in error_state(eta, att, nu, refm, VP))
+    e, ed, _ = (np.array(v) for v in error_state(eta, att, nu, refm, VP_NOM))
     z2 = ed + 0.7 * e
     assert status == 0
     _close(e_ddot_nominal(eta, nu, tau, refm), -0.7 * ed - e - 1.3 * z2 - bh)
@@ -147,7 +149,7 @@ def test_sta_commands_its_design_law_at_any_state(seed):
     cc = _setup(sta, ["controller.lam=0.6", "controller.k1=1.7", "controller.k2=0.9"])
     v = rng.normal(0.0, 0.5, 3)
     status, tau, dxc, aux = _call(sta, cc, t, eta, nu, att, v, refm)
-    e, ed, _ = (np.array(x) for x in error_state(eta, att, nu, refm, VP))
+    e, ed, _ = (np.array(x) for x in error_state(eta, att, nu, refm, VP_NOM))
     s = ed + 0.6 * e
     assert status == 0
     _close(e_ddot_nominal(eta, nu, tau, refm) + 0.6 * ed, -1.7 * np.sqrt(np.abs(s)) * np.sign(s) + v)
@@ -171,9 +173,9 @@ def test_ppc_transformed_error_obeys_its_design_law_at_any_state(seed):
     cc = _setup(ppc, ["controller.kp=3.0", "controller.kd=2.5", "controller.l=0.4"])
     rho = np.array([ppc.envelope(t, r0, ri, 0.4) for r0, ri in zip(ppc.Params().rho0, (0.005,) * 3)])
     xi = rng.uniform(-0.95, 0.95, 3)
-    refm[0] = np.array(virtual_point(eta, att, VP[ELL])) - xi * rho[:, 0]  # e = xi rho
+    refm[0] = np.array(virtual_point(eta, att, VP_NOM[LAYOUT.ell])) - xi * rho[:, 0]  # e = xi rho
     status, tau, _, aux = _call(ppc, cc, t, eta, nu, att, np.zeros(0), refm)
-    e, ed, _ = (np.array(x) for x in error_state(eta, att, nu, refm, VP))
+    e, ed, _ = (np.array(x) for x in error_state(eta, att, nu, refm, VP_NOM))
     epsdd, epsd = _eps_ddot(e, ed, e_ddot_nominal(eta, nu, tau, refm), *rho.T)
     assert status == 0
     _close(epsdd, -3.0 * np.arctanh(xi) - 2.5 * epsd, 1e-6)
@@ -183,7 +185,7 @@ def test_ppc_transformed_error_obeys_its_design_law_at_any_state(seed):
 def test_ppc_reports_an_error_on_its_envelope():
     _, eta, nu, att, refm, _ = _state(1)
     cc = _setup(ppc)
-    refm[0] = np.array(virtual_point(eta, att, VP[ELL])) - (0.0, ppc.Params().rho0[1], 0.0)  # e_y = rho0_y, t = 0
+    refm[0] = np.array(virtual_point(eta, att, VP_NOM[LAYOUT.ell])) - (0.0, ppc.Params().rho0[1], 0.0)  # e_y = rho0_y, t = 0
     assert _call(ppc, cc, 0.0, eta, nu, att, np.zeros(0), refm)[0] == 1
     assert ppc.STATUS[1].startswith("envelope violated")
 
@@ -197,9 +199,9 @@ def test_ftsmc_commands_its_design_law_at_any_state(seed):
     """
     _, eta, nu, att, refm, t = _state(seed)
     sc = load_scenario(PAPER, ["controller={kind=\"ftsmc\", beta=0.8, gamma=1.3, k1=0.07, k2=1.6}"])
-    cc = ftsmc.setup(sc, SimpleNamespace(vp_nom=VP, refm0=np.zeros((3, 3)), e0=np.zeros(3), seed=0))
+    cc = ftsmc.setup(sc.controller, SimpleNamespace(vp_nom=VP_NOM, refm0=np.zeros((3, 3)), e0=np.zeros(3), seed=0))
     status, tau, _, aux = _call(ftsmc, cc, t, eta, nu, att, np.zeros(0), refm)
-    e, ed, _ = (np.array(x) for x in error_state(eta, att, nu, refm, VP))
+    e, ed, _ = (np.array(x) for x in error_state(eta, att, nu, refm, VP_NOM))
     sig = lambda x, p: np.abs(x) ** p * np.sign(x)  # noqa: E731
     s = e + 0.8 * sig(ed, 1.3)
     assert status == 0
@@ -214,7 +216,7 @@ def _initial_errors(res):
     eta = tuple(res[c][0] for c in ("x", "y", "z", "theta", "psi"))
     nu = tuple(res[c][0] for c in ("u", "v", "w", "q", "r"))
     refm0 = np.vstack(build_reference({"kind": "helix"}).evaluate(0.0))  # Section 4's helix
-    e, ed, _ = error_state(eta, attitude(eta[3], eta[4]), nu, refm0, VP)
+    e, ed, _ = error_state(eta, attitude(eta[3], eta[4]), nu, refm0, VP_NOM)
     return np.array(e), np.array(ed)
 
 

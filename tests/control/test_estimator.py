@@ -118,7 +118,7 @@ def test_weight_derivative_is_the_formula_of_each_law(kind):
     or G_i = Omega_i - c1_i, psi and Omega computed here from the state, not read from the law."""
     sc, prep, ts, Xs, dXs, auxs = _law_at_states(kind)
     m, b = sc.estimator.neurons, sc.estimator.width
-    centres = prep.cp[fxtntsmc.CENT:fxtntsmc.CENT + 6 * m].reshape(m, 6)
+    centres = prep.cp[fxtntsmc.GAINS.centres:fxtntsmc.GAINS.centres + 6 * m].reshape(m, 6)
     col = {n: i for i, n in enumerate(fxtntsmc.AUX_NAMES)}
     eprm = prep.cp
     n_differs = 0
@@ -126,13 +126,13 @@ def test_weight_derivative_is_the_formula_of_each_law(kind):
         e, ed = _errors(prep, ts[n], Xs[n])
         x = np.concatenate([e, ed])
         psi = np.exp(-np.sum((x - centres) ** 2, axis=1) / (2 * b * b))
-        W = Xs[n, NXP + fxtntsmc.WEIGHTS:NXP + fxtntsmc.WEIGHTS + 3 * m].reshape(3, m)
-        dW = dXs[n, fxtntsmc.WEIGHTS:fxtntsmc.WEIGHTS + 3 * m].reshape(3, m)
+        W = Xs[n, NXP + fxtntsmc.STATE.weights:NXP + fxtntsmc.STATE.weights + 3 * m].reshape(3, m)
+        dW = dXs[n, fxtntsmc.STATE.weights:fxtntsmc.STATE.weights + 3 * m].reshape(3, m)
         for i, a in enumerate("xyz"):
             S, rho = auxs[n, col[f"sliding_{a}"]], auxs[n, col[f"rho_{a}"]]
             omega = rho / (rho * rho - e[i] * e[i])
-            _, tr = envelopes.axis_transform(envelopes.PROACTIVE, ts[n], e[i], ed[i], Xs[n, NXP + fxtntsmc.RHO_BAR + i],
-                                             eprm, fxtntsmc.EP0, i)
+            _, tr = envelopes.axis_transform(envelopes.PROACTIVE, ts[n], e[i], ed[i], Xs[n, NXP + fxtntsmc.STATE.rho_bar + i],
+                                             eprm, fxtntsmc.GAINS.envelope_params, i)
             G = tr[2] - tr[6]
             assert tr[2] == pytest.approx(omega, rel=1e-12)
             gain = {"printed": 1.0, "omega": omega, "effective": G}[kind]

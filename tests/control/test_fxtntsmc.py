@@ -208,7 +208,7 @@ def test_one_pow_forms_match_eq27_eq28():
 def test_setup_packs_the_precomputed_coefficients():
     from auvtrack.control import fxtntsmc as F
     p = prepare(load_scenario(PAPER, ["sim.duration=0.1", "controller.a2=0.7", "controller.alpha=0.65"]))
-    assert p.cp[F.SC1] == pytest.approx((2 - 0.7) * 0.01 ** (0.7 - 1), rel=1e-15)
+    assert p.cp[F.GAINS.c1] == pytest.approx((2 - 0.7) * 0.01 ** (0.7 - 1), rel=1e-15)
     assert p.cp[F.SC2] == pytest.approx((0.7 - 1) * 0.01 ** (0.7 - 2), rel=1e-15)
     assert p.cp[F.SB1] == pytest.approx((2 - 0.65) * 0.005 ** (0.65 - 1), rel=1e-15)
     assert p.cp[F.SB2] == pytest.approx((0.65 - 1) * 0.005 ** (0.65 - 2), rel=1e-15)

@@ -97,13 +97,13 @@ def test_params_are_validated_by_the_plugins_own_model(tmp_path, capsys):
 
 
 GOOD_SETUP = """
-def setup(scenario, ctx):
+def setup(params, ctx):
     return CompiledController(cp=np.zeros(2), xc0=np.zeros(0), aux_names=AUX_NAMES)
 """
 GOOD_LAW = """
 @njit
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
-    tau[0] = 0.0
+def control(t, y, xc, args, out):
+    out.u[0] = 0.0
     return 0
 """
 HEAD = """import numpy as np
@@ -120,7 +120,7 @@ class Params(ControllerParamsBase):
     ("no_setup", HEAD + GOOD_LAW, r"controller\.module: .*no_setup\.py does not define setup"),
     ("no_law_no_params", "AUX_NAMES = ()\n" + GOOD_SETUP,
      r"controller\.module: .*no_law_no_params\.py does not define Params, control"),
-    ("tuple_setup", HEAD + GOOD_LAW + "\ndef setup(scenario, ctx):\n    return np.zeros(2), np.zeros(0)\n",
+    ("tuple_setup", HEAD + GOOD_LAW + "\ndef setup(params, ctx):\n    return np.zeros(2), np.zeros(0)\n",
      r"controller\.module: .*tuple_setup\.py: setup must return a CompiledController \(got tuple\)"),
     ("matrix_cp", HEAD + GOOD_LAW + GOOD_SETUP.replace("np.zeros(2)", "np.zeros((2, 2))"),
      r"controller\.module: .*matrix_cp\.py: setup's cp must be a 1-D array of numbers \(got shape \(2, 2\)"),
@@ -130,7 +130,7 @@ class Params(ControllerParamsBase):
      r"controller\.module: .*tuple_status\.py: control must return an int status \(got tuple"),
     ("float_status", HEAD + GOOD_LAW.replace("return 0", "return 0.5") + GOOD_SETUP,
      r"controller\.module: .*float_status\.py: control must return an int status \(got float"),
-    ("not_compiled", HEAD + GOOD_LAW.replace("tau[0] = 0.0", "tau[0] = object()") + GOOD_SETUP,
+    ("not_compiled", HEAD + GOOD_LAW.replace("out.u[0] = 0.0", "out.u[0] = object()") + GOOD_SETUP,
      r"controller\.module: .*not_compiled\.py: control fails at the initial state: TypingError"),
     ("missing_file", None, r"controller\.module: no such file .*missing_file\.py"),
 ])
@@ -164,10 +164,10 @@ def test_a_plugin_given_by_module_name_with_its_own_status(tmp_path, monkeypatch
     (tmp_path / "my_stopper.py").write_text(HEAD + GOOD_SETUP + """
 STATUS = {11: "my stop: t > 0.5 s"}
 @njit
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
-    tau[0] = 0.0
-    tau[1] = 0.0
-    tau[2] = 0.0
+def control(t, y, xc, args, out):
+    out.u[0] = 0.0
+    out.u[1] = 0.0
+    out.u[2] = 0.0
     return 11 if t > 0.5 else 0
 """)
     monkeypatch.syspath_prepend(str(tmp_path))

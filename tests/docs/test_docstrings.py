@@ -38,7 +38,7 @@ API = [
     "auvtrack.plant.registry.PlantSpec.from_module",
     "auvtrack.engine.kernels.kernel",
     "auvtrack.engine.kernels.warmup",
-    "auvtrack.engine.kernels.law_module",
+    "auvtrack.user_modules.load_module",
     "auvtrack.batch.runner.run_batch",
     "auvtrack.reference.build_reference",
     "auvtrack.environment.build_disturbance",

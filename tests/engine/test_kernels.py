@@ -20,6 +20,7 @@ from auvtrack.plant import PLANTS
 from auvtrack.scenario import load_scenario
 from auvtrack.engine import loop as engine
 from auvtrack.engine import kernels
+from auvtrack.user_modules import load_module
 from auvtrack.simulation.pipeline import prepare, run_prepared
 
 DATA = Path(__file__).resolve().parents[1] / "data"
@@ -35,8 +36,8 @@ def test_every_kernel_part_is_copied_verbatim_under_its_decorator():
     for name, decorator in engine.KERNEL_PARTS.items():
         body = "\n".join(inspect.getsource(getattr(engine, name)).splitlines()[1:])
         assert f"@{decorator}\n{body}" in src
-    assert "law = llvm_inline(law_module('auvtrack.control.ftsmc').control)" in src
-    assert "from auvtrack.plant import five_dof as plant" in src
+    assert "law = llvm_inline(load_module('auvtrack.control.ftsmc').control)" in src
+    assert "plant = load_module('auvtrack.plant.five_dof')" in src
 
 
 def test_each_pair_has_its_own_kernel_and_module():
@@ -45,7 +46,7 @@ def test_each_pair_has_its_own_kernel_and_module():
     assert a.name != b.name
     assert kernels.kernel_module(a) is not kernels.kernel_module(b)
     law = kernels.kernel_module(a).law  # the law's code, compiled once for LLVM to inline (_jit.llvm_inline)
-    assert law.py_func.__code__ is kernels.law_module("auvtrack.control.ftsmc").control.py_func.__code__
+    assert law.py_func.__code__ is load_module("auvtrack.control.ftsmc").control.py_func.__code__
     assert law.targetoptions["forceinline"] and "inline" not in law.targetoptions
 
 
@@ -61,19 +62,20 @@ def test_a_plugin_kernel_is_named_by_the_file_content(tmp_path):
 def test_law_module_imports_a_file_once_per_content(tmp_path):
     f = tmp_path / "law_file.py"
     f.write_text("VALUE = 3\n")
-    m1 = kernels.law_module(str(f))
-    assert m1.VALUE == 3 and kernels.law_module(str(f)) is m1
+    m1 = load_module(str(f))
+    assert m1.VALUE == 3 and load_module(str(f)) is m1
     f.write_text("VALUE = 4\n")
-    assert kernels.law_module(str(f)).VALUE == 4
+    assert load_module(str(f)).VALUE == 4
     with pytest.raises(ImportError, match="no such file"):
-        kernels.law_module(str(tmp_path / "absent.py"))
+        load_module(str(tmp_path / "absent.py"))
 
 
-def test_editing_any_package_source_selects_a_fresh_cache(tmp_path):
-    """The cache folder is named by a hash of every package source (Numba keys only by the caller's file)."""
+def test_editing_a_compiled_source_selects_a_fresh_cache_and_only_then(tmp_path):
+    """The cache folder is named by a hash of the compiled sources (Numba keys only by the caller's file):
+    an edit of a callee of every kernel selects a new folder, an edit of the command line does not."""
     pkg = tmp_path / "auvtrack"
     shutil.copytree(Path(auvtrack.__file__).parent, pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    code = "import auvtrack.engine.jit as j; print(j.cache_dir())"
+    code = "import auvtrack.jit as j; print(j.cache_dir())"
     env = {**os.environ, "PYTHONPATH": str(tmp_path), "AUVTRACK_CACHE_DIR": str(tmp_path / "cache")}
 
     def folder():
@@ -81,7 +83,10 @@ def test_editing_any_package_source_selects_a_fresh_cache(tmp_path):
                               check=True).stdout.strip()
 
     before = folder()
-    dyn = pkg / "plant" / "dynamics.py"  # a callee of every kernel, not the file of any kernel
+    cli = pkg / "cli" / "run.py"  # no compiled code
+    cli.write_text(cli.read_text() + "\n# edited\n")
+    assert folder() == before
+    dyn = pkg / "vehicle" / "dynamics.py"  # a callee of every kernel, not the file of any kernel
     dyn.write_text(dyn.read_text() + "\n# edited\n")
     after = folder()
     assert before != after and Path(after).parent == Path(before).parent

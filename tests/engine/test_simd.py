@@ -23,15 +23,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import lane_cases
-from auvtrack.engine.lane_values import as_lanes, full_mask, get_lane
+from auvtrack.jit.lane_values import as_lanes, full_mask, get_lane
 from auvtrack.batch.runner import StopSignal, _run_simd, run_batch
 from auvtrack.simulation.compiling import builtin_controllers
 from auvtrack.scenario import load_scenario, paper_scenario_path
 from auvtrack.engine import loop as engine
 from auvtrack.engine import kernels
+from auvtrack.user_modules import load_module
 from auvtrack.simulation.pipeline import prepare, run_prepared
 from auvtrack.engine.lanes import NotLaneable, lane_source, lane_version
-from auvtrack.simulation.metrics import METRIC_NAMES
+from auvtrack.metrics import METRIC_NAMES
 
 L = engine.LANES
 PAPER = paper_scenario_path()
@@ -99,7 +100,7 @@ _pool = st.lists(st.sampled_from([0.0, -0.0, 0.3, -0.7, 1.5, 2.0, 1e-300]) | flo
 @given(data=st.data())
 def test_calls_shared_by_lanes_give_each_lane_its_own_result(data):
     """A libm or vector-libm call whose arguments have the same bits in every active lane is made once
-    (auvtrack.engine.lane_values, auvtrack.engine.vecmath): each lane still gets the scalar function's result bit for
+    (auvtrack.jit.lane_values, auvtrack.jit.vecmath): each lane still gets the scalar function's result bit for
     bit, with the lanes of a branch all alike, alike but for a signed zero, or mixed."""
     fn, kinds = lane_cases.CASES["shared"]
     xs, ps = data.draw(_pool), data.draw(_pool)
@@ -133,9 +134,9 @@ def test_masked_stores_keep_the_other_lanes():
 
 def test_unsupported_constructs_are_refused_by_name(tmp_path):
     f = tmp_path / "odd_law.py"
-    f.write_text("from auvtrack.engine.jit import njit\n\n@njit\ndef odd(x):\n    for v in (1.0, 2.0):\n"
+    f.write_text("from auvtrack.jit import njit\n\n@njit\ndef odd(x):\n    for v in (1.0, 2.0):\n"
                  "        x = x + v\n    return x\n")
-    odd = kernels.law_module(str(f)).odd
+    odd = load_module(str(f)).odd
     with pytest.raises(NotLaneable, match="only 'for name in range"):
         lane_version(odd)
 
@@ -170,7 +171,7 @@ def test_each_law_in_lane_form_equals_the_scalar_law(kind):
     law = kernels.kernel_module(preps[0].key).law
     lane_law, lane_att = lane_version(law), lane_version(attitude)
     X, T, refm = _states(preps[0], L, 11)
-    nxc, naux = preps[0].controller.x0.size, max(1, int(preps[0].si[engine.SI_NAUX]))
+    nxc, naux = preps[0].controller.x0.size, max(1, int(preps[0].si[engine.SI.n_aux]))
     cp = np.stack([p.cp for p in preps])
     vp = np.stack([p.vp_nom for p in preps])
     xc = np.stack([p.controller.x0 for p in preps])
@@ -289,15 +290,15 @@ def test_a_law_without_lane_form_runs_on_threads(tmp_path):
     """A law the rewrite does not handle: the group runs on the thread back end, same results."""
     law = tmp_path / "tuple_loop_law.py"
     law.write_text(textwrap.dedent('''
-        from auvtrack.engine.jit import njit
+        from auvtrack.jit import njit
         from auvtrack.control.ftsmc import control as ftsmc_control
 
         @njit
-        def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+        def control(t, y, xc, args, out):
             s = 0.0
             for g in (1.0, 2.0):  # iterating a tuple: no lane form
                 s += g
-            return ftsmc_control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work) + int(s - 3.0)
+            return ftsmc_control(t, y, xc, args, out) + int(s - 3.0)
     '''))
     from auvtrack.batch.runner import MIN_LANES
 
@@ -316,13 +317,13 @@ def test_a_lane_form_numba_cannot_type_runs_on_threads(tmp_path):
     law = tmp_path / "gamma_law.py"
     law.write_text(textwrap.dedent('''
         import math
-        from auvtrack.engine.jit import njit
+        from auvtrack.jit import njit
         from auvtrack.control.ftsmc import control as ftsmc_control
 
         @njit
-        def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
-            g = math.gamma(2.0 + min(abs(eta[0]), 1.0))  # finite: g - g = 0
-            return ftsmc_control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work) + int(g - g)
+        def control(t, y, xc, args, out):
+            g = math.gamma(2.0 + min(abs(y.eta[0]), 1.0))  # finite: g - g = 0
+            return ftsmc_control(t, y, xc, args, out) + int(g - g)
     '''))
     base = [prepare(load_scenario(PAPER, {"controller.kind": "ftsmc", "seed": i, "sim.duration": 0.2}))
             for i in range(L)]

@@ -1,4 +1,4 @@
-"""Fast forms of the hot path against their readable forms: vector libm calls (auvtrack.engine.vecmath), the law using them, the fused RBF update."""
+"""Fast forms of the hot path against their readable forms: vector libm calls (auvtrack.jit.vecmath), the law using them, the fused RBF update."""
 from __future__ import annotations
 
 import math
@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from auvtrack.engine import jit as _jit
 from auvtrack.engine import vecmath as _vecmath
-from auvtrack.engine.vecmath import atanh4, exp8, pow4, sincos4
+from auvtrack.jit.vecmath import atanh4, exp8, pow4, sincos4
 from auvtrack.control import fxtntsmc
 from auvtrack.control.fxtntsmc import rbf
 
@@ -74,7 +74,7 @@ def test_cache_directory_names_the_backend():
 
 def test_the_lane_kernels_8_lane_calls_select_another_cache_directory():
     """AUVTRACK_LIBMVEC_AVX512=0 changes the lane kernels' code (4-lane calls only), so their cache too."""
-    code = "import auvtrack.engine.vecmath as v, auvtrack.engine.jit as j; print(len(v.WIDE), j.cache_dir().name)"
+    code = "import auvtrack.jit.vecmath as v, auvtrack.jit as j; print(len(v.WIDE), j.cache_dir().name)"
     names = {}
     for flag in ("0", "1"):
         out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "AUVTRACK_LIBMVEC_AVX512": flag},
@@ -87,7 +87,7 @@ def test_the_lane_kernels_8_lane_calls_select_another_cache_directory():
 
 def test_libmvec_can_be_switched_off():
     """AUVTRACK_LIBMVEC=0 selects the scalar loops (and therefore another cache directory)."""
-    code = "import auvtrack.engine.vecmath as v, auvtrack.engine.jit as j; print(v.BACKEND, j.cache_dir().name)"
+    code = "import auvtrack.jit.vecmath as v, auvtrack.jit as j; print(v.BACKEND, j.cache_dir().name)"
     out = subprocess.run([sys.executable, "-c", code], env={**os.environ, "AUVTRACK_LIBMVEC": "0"},
                          capture_output=True, text=True, check=True).stdout.split()
     assert out[0] == "scalar" and out[1].endswith("-scalar")  # (no 8-lane calls without libmvec)

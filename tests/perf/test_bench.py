@@ -31,7 +31,7 @@ def test_cli_bench_prints_one_json_line_per_controller():
 
 
 def test_results_name_the_vector_math_back_end(tmp_path):
-    """Results depend on the vector-math back end (auvtrack.engine.vecmath), so the record says which."""
+    """Results depend on the vector-math back end (auvtrack.jit.vecmath), so the record says which."""
     from pathlib import Path
 
     from auvtrack.engine import vecmath as _vecmath
@@ -129,16 +129,19 @@ def test_bench_all_leaves_the_working_tree_unchanged(tmp_path):
 
 
 def test_warmup_covers_every_builtin_controller_on_every_plant_it_runs_on():
-    """Warmup's default pairs: each built-in controller (the 6-DOF-only one on the 6-DOF plant only) on
-    every plant, which warmup expands to one kernel per preset module."""
-    from auvtrack.control import BUILTIN_NAMES
+    """Warmup's default pairs come from the capabilities: each built-in controller on every built-in
+    plant that accepts what it commands (the actuator-commanding one on the 6-DOF plant only), one
+    kernel per pair whatever the preset."""
+    from auvtrack.control import BUILTIN_NAMES, CONTROLLERS
+    from auvtrack.plant import BUILTIN_NAMES as PLANT_NAMES
     from auvtrack.plant import PLANTS
-    from auvtrack.simulation.compiling import SIXDOF_ONLY, builtin_pairs
+    from auvtrack.simulation.compiling import builtin_pairs, kernel_keys
 
     pairs = builtin_pairs()
     assert {c for c, _ in pairs} == set(BUILTIN_NAMES)
     for c in BUILTIN_NAMES:
         plants = {p for k, p in pairs if k == c}
-        assert plants == ({"6dof"} if c in SIXDOF_ONLY else set(PLANTS))
-    assert len(PLANTS["6dof"].kernel_modules) >= 2  # the preset modules: one kernel each
+        assert plants == {p for p in PLANT_NAMES if CONTROLLERS[c].commands in PLANTS[p].accepts}
+    assert {p for k, p in pairs if k == "open_loop_actuators"} == {"6dof"}
+    assert len(kernel_keys(pairs)) == len(pairs)
     assert builtin_pairs(("ftsmc",), ("5dof",)) == [("ftsmc", "5dof")]

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from auvtrack.simulation.metrics import (METRIC_NAMES, METRICS_SIZE, TV_GRID, metrics_finalize,
+from auvtrack.metrics import (METRIC_NAMES, METRICS_SIZE, TV_GRID, metrics_finalize,
                                          metrics_from_trajectory, metrics_init, metrics_update)
 
 

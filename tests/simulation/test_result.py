@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 from scipy.io import loadmat
 
 import auvtrack
-from auvtrack.simulation.metrics import METRIC_NAMES, metrics_from_trajectory
+from auvtrack.metrics import METRIC_NAMES, metrics_from_trajectory
 from auvtrack.simulation.plotting import KINDS, plot_runs, save_figure
 from auvtrack.simulation.result import BASE_CHANNELS, Result, restore_nonfinite, to_jsonable
 
@@ -115,13 +115,9 @@ def test_constructor_validation():
 
 def test_to_pandas():
     res = make_result()
-    df = res.to_pandas(legacy_names=False)
+    df = res.to_pandas()
     assert list(df.columns) == list(res.names)
     assert df.shape == (len(res), len(res.names))
-    # for one release the renamed channels also appear under their old names, after every channel
-    legacy = res.to_pandas()
-    assert list(legacy.columns) == list(res.names) + ["S_x", "S_y", "S_z"]
-    np.testing.assert_array_equal(legacy["S_y"].to_numpy(), res["sliding_y"])
     np.testing.assert_array_equal(df["ex"].to_numpy(), res["ex"])
     df.loc[0, "x"] = 123.0  # the frame is a copy
     assert res["x"][0] != 123.0

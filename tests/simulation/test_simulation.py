@@ -98,7 +98,7 @@ def test_sampled_data_mode_runs_and_holds_the_input():
 
 
 def test_metrics_match_the_reference_implementation_when_logging_every_step():
-    from auvtrack.simulation.metrics import metrics_from_trajectory
+    from auvtrack.metrics import metrics_from_trajectory
 
     res = auvtrack.simulate(PAPER, ["controller.kind=ftsmc", "sim.duration=4", "sim.log_dt=0.001"])
     e = np.column_stack([res["ex"], res["ey"], res["ez"]])

@@ -177,7 +177,8 @@ def test_sampled_law_uses_the_attitude_of_the_measured_state(kind):
     from auvtrack.vehicle.kinematics import attitude
     from auvtrack.scenario import load_scenario
     from auvtrack.simulation.pipeline import prepare, run_prepared
-    from auvtrack.engine.kernels import law_module
+    from auvtrack.control.contract import UNLIMITED, LawArgs, LawOutputs, Measured
+    from auvtrack.user_modules import load_module
 
     sc = load_scenario({}, ["sim.duration=0.05", "sim.control_rate=100", f"controller.kind={kind}",
                             "sensor.sigma_eta=[0, 0, 0, 0.05, 0.05]"])
@@ -185,11 +186,12 @@ def test_sampled_law_uses_the_attitude_of_the_measured_state(kind):
     first = run_prepared(p).to_pandas().iloc[0]  # the input applied on [0, 10 ms) is the law at sample 0
     x0 = p.plant.x0
     eta, nu = measure(tuple(x0[:5]), tuple(x0[5:10]), p.noise, 0)
-    control = law_module(p.key.law).control
+    control = load_module(p.key.law).control
 
     def law(att):
         tau, dxc, aux, work = np.zeros(3), np.zeros(p.controller.x0.size), np.zeros(64), np.zeros(WORK_SIZE)
-        assert control(0.0, eta, nu, att, p.controller.x0, _ref0(p), p.vp_nom, p.cp, tau, dxc, aux, work) == 0
+        args = LawArgs(_ref0(p), p.ref_p, p.cp, p.vp_nom, *UNLIMITED, (0.0, 0.0, 0.0), 0.0, work)
+        assert control(0.0, Measured(eta, nu, att), p.controller.x0, args, LawOutputs(tau, dxc, aux)) == 0
         return tau
 
     measured, true = law(attitude(eta[3], eta[4])), law(attitude(x0[3], x0[4]))

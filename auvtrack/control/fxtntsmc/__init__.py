@@ -32,8 +32,9 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ...engine.jit import njit, njit_noalloc
-from ...engine.vecmath import atanh4, pow4
+from ...jit import njit, njit_noalloc
+from ...jit.vecmath import atanh4, pow4
+from ...packing import packed_layout
 from . import envelopes
 from . import rbf
 from ..registry import CompiledController, ControllerParams
@@ -42,22 +43,22 @@ from ..tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "fxtntsmc"
 AXES = ("x", "y", "z")
-# channel names (formerly S_* and z_*, still readable: auvtrack/simulation/channels.py)
-AUX_NAMES = tuple(f"{n}_{a}" for n in ("rho", "rho1", "chi_hat", "sliding", "g", "zeta", "gain_ratio")
-                  for a in AXES)
+SECTIONS = ("envelope", "estimator")
+AUX = packed_layout("FXTNTSMCChannels", rho=3, rho1=3, chi_hat=3, sliding=3, g=3, zeta=3, gain_ratio=3)
+"""Logged channels per axis: envelope rho and its baseline rho1, the estimate chi_hat, the sliding
+variable S, the risk indicator g, the transformed error zeta (eq. 17) and G/Omega."""
+AUX_NAMES = tuple(f"{n}_{a}" for n in AUX.names for a in AXES)
 
-# Packed parameters cp (built by :func:`setup`):
-#   0-11   kappa1, kappa2, kappa3, a1, a2, a3, a4, alpha, sigma, surface code, z_switch, z_floor
-#   12     envelope kind;  13-26  the 14 envelope parameters of envelopes.axis_transform
-#   27-30  constants precomputed once (they only depend on gains): c1, c2 of the nonsingular
-#          quadratic (surface_coeffs) and beta1, beta2 of eq. (27) (switch_coeffs)
-#   31-33  estimator code, neurons m, RBF width;  34-  the 6 m RBF centres
-K1, K2, K3, A1, A2, A3, A4, ALPHA, SIGMA, SURF, ZSW, ZFL = range(12)
-ENV, EP0 = 12, 13  # envelope kind, then the 14 envelope parameters of envelopes.axis_transform
-SC1, SC2, SB1, SB2 = 27, 28, 29, 30
-EST, NEUR, WIDTH, CENT = 31, 32, 33, 34
+GAINS = packed_layout("FXTNTSMCParams", kappa1=1, kappa2=1, kappa3=1, a1=1, a2=1, a3=1, a4=1, alpha=1, sigma=1,
+                      surface=1, z_switch=1, z_floor=1, envelope=1, envelope_params=envelopes.PARAMS.size,
+                      c1=1, c2=1, beta1=1, beta2=1, estimator=1, neurons=1, width=1, centres=None)
+"""Packed parameters (:func:`setup`): the gains, the envelope kind and its parameters
+(:func:`envelopes.axis_transform`), constants precomputed from the gains (c1, c2 of the
+nonsingular quadratic, :func:`surface_coeffs`; beta1, beta2 of eq. 27, :func:`switch_coeffs`), the
+estimator, and the 6 m RBF centres."""
+STATE = packed_layout("FXTNTSMCState", rho_bar=3, weights=None)
+"""Internal state xc: the envelope filters rho_bar (3), then the RBF weights W (3 m)."""
 SURFACES = {"nonsingular": 0, "printed": 1}
-RHO_BAR, WEIGHTS = 0, 3  # internal state xc = [rho_bar (3), W (3 m)]
 MAX_NEURONS = WORK_SIZE  # the basis psi occupies work[0:m]
 
 
@@ -129,7 +130,7 @@ def pow_and_power_below(x, p):
 def powers_below3(x, p, need):
     """:func:`power_below` of the bases ``x`` (3-tuple) for the lanes where ``need`` (3 booleans) is true.
 
-    Two or three needed powers take one vector call (:func:`auvtrack.engine.vecmath.pow4`), which
+    Two or three needed powers take one vector call (:func:`auvtrack.jit.vecmath.pow4`), which
     returns every lane within 4 ulp of :func:`power_below`; a single needed power is one scalar
     call (exactly :func:`power_below`) and the other lanes are 1.  p = 2 returns the bases.
     """
@@ -231,8 +232,8 @@ def reaching_law(S, k1, k2, k3):
 @njit_noalloc(inline="always")
 def _transform(kind, shape, cp, eprm, e, ed, xc, i):
     """Envelope and error transformation of axis ``i`` (eq. 17-25) with xi for z, :func:`envelopes.axis_transform_xi`."""
-    r1 = envelopes.axis_baseline(shape, cp, EP0, i)
-    return envelopes.axis_transform_xi(kind, e[i], ed[i], xc[RHO_BAR + i], eprm, r1)
+    r1 = envelopes.axis_baseline(shape, cp, GAINS.envelope_params, i)
+    return envelopes.axis_transform_xi(kind, e[i], ed[i], xc[STATE.rho_bar + i], eprm, r1)
 
 
 @njit_noalloc(inline="always")
@@ -244,33 +245,34 @@ def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux):
     chi_hat, which the estimator's update of the three axes fills in afterwards.
     """
     _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
-    s1, dphi = switch_q(se, cp[ALPHA], cp[SIGMA], cp[SB1], cp[SB2], qs)
+    s1, dphi = switch_q(se, cp[GAINS.alpha], cp[GAINS.sigma], cp[GAINS.beta1], cp[GAINS.beta2], qs)
     S = zd + s1
-    reach = reaching_law(S, cp[K1], cp[K2], cp[K3])
+    reach = reaching_law(S, cp[GAINS.kappa1], cp[GAINS.kappa2], cp[GAINS.kappa3])
     G = Om - c1  # > 0 (docs/derivation.md section 3)
     edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / G
-    dxc[RHO_BAR + i] = rbd
-    aux[i], aux[3 + i], aux[9 + i], aux[12 + i], aux[15 + i] = rho, rho1, S, g, z
-    aux[18 + i] = G / Om  # exactly 1 where c1 = 0
+    dxc[STATE.rho_bar + i] = rbd
+    aux[AUX.rho + i], aux[AUX.rho1 + i], aux[AUX.sliding + i], aux[AUX.g + i], aux[AUX.zeta + i] = rho, rho1, S, g, z
+    aux[AUX.gain_ratio + i] = G / Om  # exactly 1 where c1 = 0
     return S, edd, Om, G
 
 
 @njit_noalloc(inline="always")
-def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
+def control(t, y, xc, args, out):
     """Compiled FXTNTSMC law, eq. (26)-(34) corrected (tau in N, N m); status 1 if an error leaves its envelope.
 
-    ``work[0:m]`` holds the RBF basis.
+    ``args.work[0:m]`` holds the RBF basis.
     """
-    e, ed, f, gf = error_state_forces(eta, att, nu, refm, vp)
-    kind, est, m = int(cp[ENV]), int(cp[EST]), int(cp[NEUR])
+    cp, work, dxc, aux = args.cp, args.work, out.dxc, out.aux
+    e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
+    kind, est, m = int(cp[GAINS.envelope]), int(cp[GAINS.estimator]), int(cp[GAINS.neurons])
     if est != rbf.NONE:
-        rbf.basis(e, ed, cp, CENT, m, cp[WIDTH], work)
-    printed = cp[SURF] != 0.0
+        rbf.basis(e, ed, cp, GAINS.centres, m, cp[GAINS.width], work)
+    printed = cp[GAINS.surface] != 0.0
     # the baseline's exp(-t / (T - t)) is shared by the three axes (one T)
     shape = envelopes.AFTER_T
     if kind != envelopes.NONE:
-        shape = envelopes.baseline_shape(t, cp[EP0 + envelopes.EP_T])
-    eprm = envelopes.params(cp, EP0)
+        shape = envelopes.baseline_shape(t, cp[GAINS.envelope_params + envelopes.PARAMS.T])
+    eprm = envelopes.params(cp, GAINS.envelope_params)
     # three phases over the axes, so that atanh (eq. 17) and each power of eq. (27)-(28) is one vector call
     st0, tr0 = _transform(kind, shape, cp, eprm, e, ed, xc, 0)
     if st0 != 0:
@@ -287,15 +289,15 @@ def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
         zv = atanh4((xi[0], xi[1], xi[2], 0.0))  # z = atanh(xi), eq. (17)
         z = (zv[0], zv[1], zv[2])
     az = (abs(z[0]), abs(z[1]), abs(z[2]))
-    need = (surface_branch(az[0], printed, cp[ZSW], cp[ZFL]) == SURF_POWER,
-            surface_branch(az[1], printed, cp[ZSW], cp[ZFL]) == SURF_POWER,
-            surface_branch(az[2], printed, cp[ZSW], cp[ZFL]) == SURF_POWER)
-    qz = powers_below3(az, cp[A2], need)
-    se0, dse0 = surface_q(z[0], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[0])
-    se1, dse1 = surface_q(z[1], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[1])
-    se2, dse2 = surface_q(z[2], cp[A1], cp[A2], cp[A3], cp[A4], printed, cp[ZSW], cp[ZFL], cp[SC1], cp[SC2], qz[2])
+    need = (surface_branch(az[0], printed, cp[GAINS.z_switch], cp[GAINS.z_floor]) == SURF_POWER,
+            surface_branch(az[1], printed, cp[GAINS.z_switch], cp[GAINS.z_floor]) == SURF_POWER,
+            surface_branch(az[2], printed, cp[GAINS.z_switch], cp[GAINS.z_floor]) == SURF_POWER)
+    qz = powers_below3(az, cp[GAINS.a2], need)
+    se0, dse0 = surface_q(z[0], cp[GAINS.a1], cp[GAINS.a2], cp[GAINS.a3], cp[GAINS.a4], printed, cp[GAINS.z_switch], cp[GAINS.z_floor], cp[GAINS.c1], cp[GAINS.c2], qz[0])
+    se1, dse1 = surface_q(z[1], cp[GAINS.a1], cp[GAINS.a2], cp[GAINS.a3], cp[GAINS.a4], printed, cp[GAINS.z_switch], cp[GAINS.z_floor], cp[GAINS.c1], cp[GAINS.c2], qz[1])
+    se2, dse2 = surface_q(z[2], cp[GAINS.a1], cp[GAINS.a2], cp[GAINS.a3], cp[GAINS.a4], printed, cp[GAINS.z_switch], cp[GAINS.z_floor], cp[GAINS.c1], cp[GAINS.c2], qz[2])
     ase = (abs(se0), abs(se1), abs(se2))
-    qs = powers_below3(ase, cp[ALPHA], (ase[0] > cp[SIGMA], ase[1] > cp[SIGMA], ase[2] > cp[SIGMA]))
+    qs = powers_below3(ase, cp[GAINS.alpha], (ase[0] > cp[GAINS.sigma], ase[1] > cp[GAINS.sigma], ase[2] > cp[GAINS.sigma]))
     S0, edd0, om0, G0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux)
     S1, edd1, om1, G1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux)
     S2, edd2, om2, G2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux)
@@ -306,10 +308,10 @@ def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
             gain = (om0, om1, om2)
         elif est == rbf.EFFECTIVE:
             gain = (G0, G1, G2)
-        chat = rbf.estimate_and_adapt3(xc, WEIGHTS, m, work, (S0, S1, S2), gain, dxc)
-    aux[6], aux[7], aux[8] = chat
+        chat = rbf.estimate_and_adapt3(xc, STATE.weights, m, work, (S0, S1, S2), gain, dxc)
+    aux[AUX.chi_hat], aux[AUX.chi_hat + 1], aux[AUX.chi_hat + 2] = chat
     acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])
-    tau[0], tau[1], tau[2] = input_for_accel_forces(att, vp, f, acc, gf)
+    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, acc, gf)
     return 0
 
 
@@ -339,9 +341,9 @@ def start_widening(e0, rho1_0, xi0: float, widen: bool) -> tuple[np.ndarray, lis
     return rb, notes
 
 
-def setup(scenario, ctx) -> CompiledController:
-    """Pack gains, envelope and network of the scenario; apply the start treatment."""
-    p, env, est = scenario.controller, scenario.envelope, scenario.estimator
+def setup(params: Params, ctx) -> CompiledController:
+    """Pack gains, envelope (``[envelope]``) and network (``[estimator]``); apply the start treatment."""
+    p, env, est = params, ctx.section("envelope"), ctx.section("estimator")
     kind = envelopes.ENVELOPES[env.kind]
     rho0, rho_inf = np.asarray(env.rho0, float), np.asarray(env.rho_inf, float)
     printed = env.baseline == "printed"
@@ -354,16 +356,36 @@ def setup(scenario, ctx) -> CompiledController:
     if m > MAX_NEURONS:
         raise ValueError(f"estimator.neurons: at most {MAX_NEURONS} (got {m})")
     centres, weights = rbf.draw_network(ctx.seed, m, est.centre_range, est.weight_range)
-    cp = np.concatenate([
-        [p.kappa1, p.kappa2, p.kappa3, p.a1, p.a2, p.a3, p.a4, p.alpha, p.sigma,
-         SURFACES[p.surface], p.z_switch, p.z_floor, kind,
-         env.T, env.delta, env.epsilon, env.lambda1, env.lambda2, env.lambda3, env.reactive_threshold,
-         float(printed)], rho0, rho_inf,
-        surface_coeffs(p.a2, p.z_switch), switch_coeffs(p.alpha, p.sigma),
-        [rbf.ESTIMATORS[est.kind], m, est.width], centres.ravel(),
-    ]).astype(np.float64)
-    assert cp.size == CENT + 6 * m and cp[EST] == rbf.ESTIMATORS[est.kind]
-    xc0 = np.concatenate([rb0, weights.ravel()])
+    c1, c2 = surface_coeffs(p.a2, p.z_switch)
+    beta1, beta2 = switch_coeffs(p.alpha, p.sigma)
+    cp = GAINS.pack(kappa1=p.kappa1, kappa2=p.kappa2, kappa3=p.kappa3, a1=p.a1, a2=p.a2, a3=p.a3, a4=p.a4,
+                    alpha=p.alpha, sigma=p.sigma, surface=SURFACES[p.surface], z_switch=p.z_switch,
+                    z_floor=p.z_floor, envelope=kind,
+                    envelope_params=envelopes.PARAMS.pack(
+                        T=env.T, delta=env.delta, epsilon=env.epsilon, lambda1=env.lambda1, lambda2=env.lambda2,
+                        lambda3=env.lambda3, threshold=env.reactive_threshold, printed=float(printed), rho0=rho0,
+                        rho_inf=rho_inf),
+                    c1=c1, c2=c2, beta1=beta1, beta2=beta2,
+                    estimator=rbf.ESTIMATORS[est.kind], neurons=m, width=est.width, centres=centres.ravel())
+    xc0 = STATE.pack(rho_bar=rb0, weights=weights.ravel())
     resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
     return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),
                               resolved=resolved)
+
+
+def warnings(params: Params) -> list[str]:
+    """The conditions of Theorem 1 that ``params`` break (:func:`auvtrack.control.fxtntsmc.theory.check_theorem1`).
+
+    Parameters
+    ----------
+    params : Params
+        The gains.
+
+    Returns
+    -------
+    list of str
+        One line per violated condition.
+    """
+    from .theory import check_theorem1
+
+    return list(check_theorem1(params))

@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import math
 
-from ...engine.jit import njit
+from ...jit import njit
+from ...packing import packed_layout
 
 NONE, RIGID, REACTIVE, PROACTIVE = 0, 1, 2, 3
 ENVELOPES = {"none": NONE, "rigid": RIGID, "reactive": REACTIVE, "proactive": PROACTIVE}
@@ -126,25 +127,23 @@ def solve_risk_loop(h0, k, eps):
     return g
 
 
-# packed envelope parameters ep[off : off + N_PARAMS]
-EP_T, EP_DELTA, EP_EPS, EP_LAM1, EP_LAM2, EP_LAM3, EP_THR, EP_PRINTED, EP_RHO0, EP_RHOINF = (
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 11)  # rho0 and rho_inf take 3 slots each (x, y, z)
-N_PARAMS = 14
+PARAMS = packed_layout("EnvelopeParams", T=1, delta=1, epsilon=1, lambda1=1, lambda2=1, lambda3=1, threshold=1,
+                       printed=1, rho0=3, rho_inf=3)
+"""Packed envelope parameters ``ep[off : off + PARAMS.size]`` (rho0, rho_inf: x, y, z)."""
 OUTSIDE = (math.nan,) * 11
 
 
 @njit
 def axis_baseline(shape, ep, off, i):
     """rho1, rho1_dot, rho1_ddot of eq. (24) for axis ``i`` from :func:`baseline_shape`."""
-    return baseline_from_shape(shape, ep[off + EP_RHO0 + i], ep[off + EP_RHOINF + i], ep[off + EP_PRINTED] != 0.0)
+    return baseline_from_shape(shape, ep[off + PARAMS.rho0 + i], ep[off + PARAMS.rho_inf + i], ep[off + PARAMS.printed] != 0.0)
 
 
 @njit
 def axis_transform(kind, t, e, ed, rb, ep, off, i):
     """Envelope and error transformation of axis ``i`` (eq. 17-19, 23-25).
 
-    ``ep[off : off + 14]`` = [T, delta, eps, lambda1, lambda2, lambda3, thr, printed,
-    rho0 (3), rho_inf (3)].  Returns (status, values) with status 1 if |e| >= rho (outside the
+    ``ep[off : off + PARAMS.size]`` in the layout :data:`PARAMS`.  Returns (status, values) with status 1 if |e| >= rho (outside the
     envelope) and values = (z, z_dot, Omega, U, Omega_dot, c0, c1, rho, rho_bar_dot, rho1, g),
     where U_dot e = c0 + c1 e_ddot collects every U_dot term (loop 2 of ERRATA 10), so that
     z_ddot = Omega_dot e_dot + Omega e_ddot - (c0 + c1 e_ddot) - U e_dot.
@@ -152,7 +151,7 @@ def axis_transform(kind, t, e, ed, rb, ep, off, i):
     prm = params(ep, off)
     if kind == NONE:
         return axis_transform_given(kind, e, ed, rb, prm, (math.nan, 0.0, 0.0))
-    r1 = axis_baseline(baseline_shape(t, ep[off + EP_T]), ep, off, i)
+    r1 = axis_baseline(baseline_shape(t, ep[off + PARAMS.T]), ep, off, i)
     return axis_transform_given(kind, e, ed, rb, prm, r1)
 
 
@@ -166,9 +165,9 @@ def _tanh_and_slope(a, lam3):
 
 @njit
 def params(ep, off):
-    """(delta, eps, lambda1, lambda2, lambda3, thr) from ``ep[off : off + 14]`` as a tuple."""
-    return (ep[off + EP_DELTA], ep[off + EP_EPS], ep[off + EP_LAM1], ep[off + EP_LAM2], ep[off + EP_LAM3],
-            ep[off + EP_THR])
+    """(delta, eps, lambda1, lambda2, lambda3, thr) from ``ep[off : off + PARAMS.size]`` as a tuple."""
+    return (ep[off + PARAMS.delta], ep[off + PARAMS.epsilon], ep[off + PARAMS.lambda1], ep[off + PARAMS.lambda2], ep[off + PARAMS.lambda3],
+            ep[off + PARAMS.threshold])
 
 
 @njit(inline="always")

@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...engine.jit import njit_noalloc
-from ...engine.vecmath import exp8
+from ...jit import njit_noalloc
+from ...jit.vecmath import exp8
 from ..._seeding import rng
 
 NONE, PRINTED, OMEGA, EFFECTIVE = 0, 1, 2, 3
@@ -46,7 +46,7 @@ def basis(e, ed, cp, off, m, width, psi):
     """Gaussian basis psi(x) of eq. (12), x = [e, e_dot], written to psi[0:m].
 
     psi_j = exp(-||x - c_j||^2 / (2 b^2)), b = ``width``, eight neurons per
-    :func:`auvtrack.engine.vecmath.exp8` (two 4-lane libmvec calls, within 4 ulp of libm's exp).  The centres are
+    :func:`auvtrack.jit.vecmath.exp8` (two 4-lane libmvec calls, within 4 ulp of libm's exp).  The centres are
     ``cp[off : off + 6 m]``, row j = (c_e (3), c_e_dot (3)).
     """
     inv = 1.0 / (2.0 * width * width)

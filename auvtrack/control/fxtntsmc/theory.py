@@ -3,7 +3,7 @@
 Three things live here (derivations in ``docs/theory.md``; equation numbers are the paper's):
 
 * :func:`check_theorem1` / :func:`require_theorem1`: the conditions of Theorem 1 on the
-  ``[controller]`` gains of :class:`~auvtrack.control.gain_presets.FXTNTSMCParams`.
+  ``[controller]`` gains of :class:`~auvtrack.control.fxtntsmc.Params`.
 * :func:`lemma1_time` / :func:`lemma1_residual`: Lemma 1 (eq. 6-7) as corrected by ERRATA 15,
   for ``V_dot <= -m1 V^m2 - n1 V^n2 + m3`` with ``0 < m2 < 1 < n2`` and ``0 < gamma1 < 1``.
 * :func:`fixed_time_bounds`: T1 (43), T21 (48), T22 (52), the residual set (44) and mu1, mu2,
@@ -98,7 +98,7 @@ def check_theorem1(params: Any) -> list[str]:
 
     Parameters
     ----------
-    params : FXTNTSMCParams or Mapping[str, float]
+    params : auvtrack.control.fxtntsmc.Params or Mapping[str, float]
         The controller gains, by scenario key (``a3`` is the theorem's b1, ``a4`` its b2,
         ``varsigma1`` its approximation-error bound).  Unvalidated values (e.g. built with
         ``model_copy(update=...)``) are accepted.
@@ -131,7 +131,7 @@ def require_theorem1(params: Any) -> None:
 
     Parameters
     ----------
-    params : FXTNTSMCParams or Mapping[str, float]
+    params : auvtrack.control.fxtntsmc.Params or Mapping[str, float]
         The controller gains.
 
     Raises
@@ -525,7 +525,7 @@ def fixed_time_bounds(
 
     Parameters
     ----------
-    params : FXTNTSMCParams or Mapping[str, float]
+    params : auvtrack.control.fxtntsmc.Params or Mapping[str, float]
         The controller gains.
     gamma1 : float
         Lemma 1 constant, in (0, 1).

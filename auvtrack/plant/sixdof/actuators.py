@@ -18,7 +18,7 @@ Section 8.4.2 (REMUS 100 actuator time constants and limits); ch. 11 (magnitude 
 """
 from __future__ import annotations
 
-from ...engine.jit import njit_noalloc
+from ...jit import njit_noalloc
 from .layout import (IX_DR, IX_DS, IX_N, P_DMAX, P_DRATE, P_NMAX, P_NRATE, P_TDELTA, P_TN)
 
 

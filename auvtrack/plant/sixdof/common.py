@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import math
 
-from ...engine.jit import njit_noalloc
+from ...jit import njit_noalloc
 from ...environment.current import current_velocity
 from ...environment.disturbances import add_paper, add_pulse
 from ...environment.layout import KIND_CURRENT, KIND_PAPER, KIND_PULSE
 from .actuators import effective
-from ..contract import CAUSE_PITCH, CAUSE_ROLL, SF_PHI_LIM, SF_THETA_LIM
+from ..contract import CAUSE_PITCH, CAUSE_ROLL, SF
 from .layout import CMD_DR, CMD_DS, CMD_N, CMD_TAU, P_DIRECT, P_DMAX, P_NMAX
 
 SCR_DIST, SCR_VC = 0, 5  # scratch: disturbance forces (5), current velocity (3)
@@ -35,10 +35,10 @@ def accel5(dx):
 
 @njit_noalloc
 def attitude_cause6(x, sf):
-    """CAUSE_PITCH if |theta| > sf[SF_THETA_LIM], CAUSE_ROLL if |phi| > sf[SF_PHI_LIM], else 0 (rad)."""
-    if abs(x[4]) > sf[SF_THETA_LIM]:
+    """CAUSE_PITCH if |theta| > sf[SF.theta_lim], CAUSE_ROLL if |phi| > sf[SF.phi_lim], else 0 (rad)."""
+    if abs(x[4]) > sf[SF.theta_lim]:
         return CAUSE_PITCH
-    if abs(x[3]) > sf[SF_PHI_LIM]:
+    if abs(x[3]) > sf[SF.phi_lim]:
         return CAUSE_ROLL
     return 0
 

@@ -36,7 +36,9 @@ P_DMAX, P_NMAX = 116, 117    # fin angle limit (rad), propeller speed limit (rpm
 P_TDELTA, P_TN = 118, 119    # actuator time constants (s)
 P_DRATE, P_NRATE = 120, 121  # actuator rate limits (rad/s, rpm/s; inf = none)
 P_DIRECT = 122               # 1: the controller commands the actuators directly (open loop)
+P_EQUATIONS = 123            # which equations of motion: EQUATIONS_PRESTERO or EQUATIONS_FOSSEN
 P_MODEL = 128                # start of the model's own block
+EQUATIONS_PRESTERO, EQUATIONS_FOSSEN = 0.0, 1.0
 PP6_SIZE = 192
 
 LOG_NAMES6 = ("phi", "p", "delta_r", "delta_s", "rpm", "tau_u_cmd", "tau_q_cmd", "tau_r_cmd")

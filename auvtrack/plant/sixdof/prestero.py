@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from ...engine.jit import njit_noalloc
+from ...jit import njit_noalloc
 from .actuators import actuator_rates, clip, effective, fin_angle_for
 from .layout import (CMD_DR, CMD_DS, CMD_N, P_B, P_DMAX, P_MA, P_MINV, P_MODEL, P_MRB, P_NMAX, P_RB,
                       P_RG, P_W, PP6_SIZE)

@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from ...engine.jit import njit_noalloc
+from ...jit import njit_noalloc
 
 G_ACC = 9.81  # m/s^2, used by both REMUS sources
 

@@ -41,15 +41,15 @@ class Truth6:
     resolved: dict
 
 
-def prepare_truth(scenario, direct: bool = False) -> Truth6:
-    """Prepare the 6-DOF truth of ``scenario`` (``plant.model == "6dof"``).
+def prepare_truth(section, ctx) -> Truth6:
+    """Prepare the 6-DOF truth of a ``[plant]`` section at the run's initial state.
 
     Parameters
     ----------
-    scenario : auvtrack.scenario.Scenario
-        Validated scenario.
-    direct : bool
-        The controller commands the actuators directly (``open_loop_actuators``).
+    section : auvtrack.plant.sixdof.Section
+        The validated section (preset, actuator overrides).
+    ctx : auvtrack.plant.registry.PlantContext
+        Initial state, what the controller commands, the design vehicle's preset.
 
     Returns
     -------
@@ -61,18 +61,18 @@ def prepare_truth(scenario, direct: bool = False) -> Truth6:
     ValueError
         ``initial.nu: ...`` when the initial surge speed is beyond the propeller's reach.
     """
-    name = scenario.plant.preset
-    limits = scenario.plant.actuator_limits()
-    pp = pack_truth(name, scenario.plant.actuator_overrides(), direct=direct)
-    e, n = scenario.initial.eta, scenario.initial.nu
+    name = section.preset
+    limits = section.actuator_limits()
+    pp = pack_truth(name, section.actuator_overrides(), direct=ctx.commands == "actuators")
+    e, n = ctx.eta0, ctx.nu0
     rpm0 = trim_rpm(name, pp, n[0])
-    x0 = initial_state((e[0], e[1], e[2], scenario.initial.phi, e[3], e[4]),
-                       (n[0], n[1], n[2], scenario.initial.p, n[3], n[4]), (0.0, 0.0, rpm0))
+    x0 = initial_state((e[0], e[1], e[2], ctx.phi0, e[3], e[4]), (n[0], n[1], n[2], ctx.p0, n[3], n[4]),
+                       (0.0, 0.0, rpm0))
     pr = load_preset6(name)
     notes = (f"6-DOF truth {name}: the controller's design model is the 5-DOF vehicle "
-             f"{scenario.vehicle.preset!r}; it measures the 5-DOF projection (no roll)",
+             f"{ctx.design_preset!r}; it measures the 5-DOF projection (no roll)",
              f"initial propeller speed {rpm0:.6g} rpm: surge balance at u = {n[0]:g} m/s",)
     resolved = {"model": "6dof", "preset": name, "description": pr.description,
-                "module": MODELS[name].__name__, "actuators": limits, "initial_rpm": rpm0,
+                "equations": MODELS[name].__name__, "actuators": limits, "initial_rpm": rpm0,
                 "coefficients": pr.record}
     return Truth6(pp=pp, x0=x0, log_names=LOG_NAMES6, notes=notes, resolved=resolved)

@@ -15,11 +15,13 @@ import numpy as np
 
 from . import fossen, prestero
 from ...vehicle.kinematics import attitude
-from .layout import (IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_DMAX, P_DRATE, P_MINV, P_NMAX, P_NRATE,
+from .layout import (EQUATIONS_FOSSEN, EQUATIONS_PRESTERO, IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_EQUATIONS, P_DMAX, P_DRATE, P_MINV, P_NMAX, P_NRATE,
                       P_TDELTA, P_TN, PP6_SIZE)
 from ...vehicle.truth_presets import Preset6, load_preset6
 
 MODELS: dict[str, ModuleType] = {"remus100_prestero": prestero, "remus100_fossen": fossen}
+EQUATIONS = {prestero: EQUATIONS_PRESTERO, fossen: EQUATIONS_FOSSEN}
+"""The code of each model's equations of motion in ``pp[P_EQUATIONS]``."""
 
 ACTUATOR_KEYS = ("delta_max", "n_max", "T_delta", "T_n", "delta_rate_max", "n_rate_max")
 _SLOTS = dict(zip(ACTUATOR_KEYS, (P_DMAX, P_NMAX, P_TDELTA, P_TN, P_DRATE, P_NRATE)))
@@ -71,6 +73,7 @@ def pack_truth(name: str, overrides: dict | None = None, direct: bool = False) -
     for k, x in actuator_values(pr, overrides).items():
         common[_SLOTS[k]] = x
     common[P_DIRECT] = 1.0 if direct else 0.0
+    common[P_EQUATIONS] = EQUATIONS[MODELS[name]]
     return MODELS[name].pack(pr, common)
 
 

@@ -1,12 +1,17 @@
-"""Compilation settings shared by every compiled kernel.
+"""Compilation settings shared by every compiled function: the decorators, inlining and the cache.
+
+This package sits below the physics (every equation module imports its decorators) and the
+engine (which compiles the loop over them); it imports nothing else of auvtrack.
 
 Numba's on-disk cache is keyed by the timestamp of the file that defines a function, not by the
-files it calls, so editing ``plant/dynamics.py`` would leave a stale cached ``simulation/engine.py``
-kernel.  We therefore place the cache in a directory named by a hash of *all* package sources:
-any source change selects a fresh directory.  The name also carries the vector-math back end of
-:mod:`auvtrack.engine.vecmath` and whether the lane kernels use its 8-lane AVX-512 functions (compiled code
-differs between them).  Set ``AUVTRACK_CACHE_DIR`` to
-override the root.
+files it calls, so editing ``vehicle/dynamics.py`` would leave a stale cached kernel.  The cache
+therefore lives in a directory named by a hash of the sources of :data:`COMPILED`, the parts of
+the package that compiled code comes from (a test checks that every module defining compiled
+functions, and every module they import, is among them): any edit there selects a fresh
+directory, an edit elsewhere (the command line, studies, reports) keeps the compiled kernels.
+The name also carries the vector-math back end of :mod:`auvtrack.jit.vecmath` and whether the
+lane kernels use its 8-lane AVX-512 functions (compiled code differs between them).  Set
+``AUVTRACK_CACHE_DIR`` to override the root.
 """
 from __future__ import annotations
 
@@ -20,30 +25,52 @@ import numba
 from numba.core import errors, types
 from numba.core.registry import CPUDispatcher
 
-from . import lane_values as _lanes  # noqa: F401  (_lanes: lane types registered before anything compiles)
-from . import vecmath as _vecmath  # noqa: F401  (_lanes: lane types registered before anything compiles)
+from . import lane_values as _lanes  # noqa: F401  (lane types registered before anything compiles)
+from . import vecmath as _vecmath
 
-_PKG = Path(__file__).resolve().parents[1]  # the whole package: any edit selects a fresh cache
+_PKG = Path(__file__).resolve().parents[1]
+COMPILED = ("jit", "packing.py", "channels.py", "metrics.py", "vehicle", "plant", "environment", "reference", "control", "engine")
+"""Packages and modules (relative to the package root) whose sources compiled code is made of."""
+
+
+def compiled_sources() -> list[Path]:
+    """The ``*.py`` files of :data:`COMPILED`, sorted."""
+    files: list[Path] = []
+    for entry in COMPILED:
+        path = _PKG / entry
+        files += [path] if path.suffix == ".py" else list(path.rglob("*.py"))
+    return sorted(files)
+
+
+def _digest(files: list[Path]) -> str:
+    h = hashlib.sha256()
+    for path in files:
+        h.update(str(path.relative_to(_PKG)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+@functools.lru_cache(maxsize=None)
+def compiled_hash() -> str:
+    """SHA-256 of the sources compiled code is made of (:func:`compiled_sources`: paths and contents).
+
+    Names the kernel cache.  Computed once per process (Numba does not reload edited sources in a
+    running process either).
+    """
+    return _digest(compiled_sources())
 
 
 @functools.lru_cache(maxsize=None)
 def source_hash() -> str:
-    """Return a SHA-256 digest of every ``*.py`` file of the package (paths and contents).
-
-    Computed once per process (Numba does not reload edited sources in a running process either).
-    """
-    h = hashlib.sha256()
-    for path in sorted(_PKG.rglob("*.py")):
-        h.update(str(path.relative_to(_PKG)).encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()
+    """SHA-256 of every ``*.py`` file of the package: the provenance of a result (sweeps, comparisons, reports)."""
+    return _digest(sorted(_PKG.rglob("*.py")))
 
 
 def cache_dir() -> Path:
     """Return the numba cache directory for the current package sources."""
     root = Path(os.environ.get("AUVTRACK_CACHE_DIR", Path.home() / ".cache" / "auvtrack"))
     wide = "-avx512" if _vecmath.WIDE else ""  # the lane kernels' 8-lane libmvec calls (AUVTRACK_LIBMVEC_AVX512)
-    return root / f"numba-{numba.__version__}-{source_hash()[:16]}-{_vecmath.BACKEND}{wide}"
+    return root / f"numba-{numba.__version__}-{compiled_hash()[:16]}-{_vecmath.BACKEND}{wide}"
 
 
 numba.config.CACHE_DIR = str(cache_dir())

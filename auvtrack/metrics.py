@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ..engine.jit import njit, njit_noalloc
+from .jit import njit, njit_noalloc
 
 AXES = ("x", "y", "z")
 INPUTS = ("u", "q", "r")

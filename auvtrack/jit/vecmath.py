@@ -68,7 +68,7 @@ BACKEND = backend()
 
 
 def _lane_signature(width: int, args) -> types.Type | None:
-    """Signature of a vector call on tuples whose entries are lane values (:mod:`auvtrack.engine.lane_values`).
+    """Signature of a vector call on tuples whose entries are lane values (:mod:`auvtrack.jit.lane_values`).
 
     Each of the ``width`` entries of each argument may be a float or lanes (L runs); the result has
     lanes in every entry.  Returns None when no argument holds lanes (the scalar signature applies).
@@ -98,7 +98,7 @@ WIDE_PAIRS = {"_ZGVdN4vv_pow": "_ZGVeN8vv_pow", "_ZGVdN4v_exp": "_ZGVeN8v_exp", 
               "_ZGVdN4v_cos": "_ZGVeN8v_cos"}
 """4-lane AVX2 libmvec functions and their 8-lane AVX-512 forms that return the same bits (glibc 2.36,
 ``tests/test_vecmath.py`` on 10^5 inputs each, specials included); the 8-lane ``atanh`` does not, so
-it is not here.  Used by lane kernels of 8 runs (:mod:`auvtrack.engine.lane_values`): one call per 8 runs."""
+it is not here.  Used by lane kernels of 8 runs (:mod:`auvtrack.jit.lane_values`): one call per 8 runs."""
 
 
 def _wide() -> dict[str, str]:
@@ -241,7 +241,7 @@ def _vector_call(name: str, width: int, nargs: int, parts: int = 1):
 
 
 # libmvec, AVX2 vector ABI: one call per 4 lanes.  With lane values (several runs at once,
-# auvtrack.engine.lane_values) each entry of the tuple is a vector of runs, 4 runs per call (_lane_call).
+# auvtrack.jit.lane_values) each entry of the tuple is a vector of runs, 4 runs per call (_lane_call).
 def _typed(name: str, width: int, sig, parts: int = 1):
     def typer(typingctx, *args):
         lane_sig = _lane_signature(width, args)
