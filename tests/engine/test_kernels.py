@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import auvtrack
-from auvtrack.engine import jit as _jit
-from auvtrack.engine import vecmath as _vecmath
+from auvtrack import jit as _jit
+from auvtrack.jit import vecmath as _vecmath
 from auvtrack.control import CONTROLLERS
 from auvtrack.plant import PLANTS
 from auvtrack.scenario import load_scenario

@@ -348,7 +348,7 @@ def test_a_stop_request_reaches_every_lane():
 
 def test_lane_kernel_lives_next_to_its_kernel_in_the_keyed_cache():
     """The SIMD module of a pair is generated in the kernel cache folder (named by the source hash)."""
-    from auvtrack.engine import jit as _jit
+    from auvtrack import jit as _jit
 
     key = prepare(load_scenario(PAPER, {"controller.kind": "ftsmc", "sim.duration": 0.01})).key
     module = kernels.lanes_module(key)

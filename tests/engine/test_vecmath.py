@@ -13,8 +13,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from auvtrack.engine import jit as _jit
-from auvtrack.engine import vecmath as _vecmath
+from auvtrack import jit as _jit
+from auvtrack.jit import vecmath as _vecmath
 from auvtrack.jit.vecmath import atanh4, exp8, pow4, sincos4
 from auvtrack.control import fxtntsmc
 from auvtrack.control.fxtntsmc import rbf

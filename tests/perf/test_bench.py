@@ -34,7 +34,7 @@ def test_results_name_the_vector_math_back_end(tmp_path):
     """Results depend on the vector-math back end (auvtrack.jit.vecmath), so the record says which."""
     from pathlib import Path
 
-    from auvtrack.engine import vecmath as _vecmath
+    from auvtrack.jit import vecmath as _vecmath
     from auvtrack.perf.bench import machine
     from auvtrack.perf.sweep_bench import write_results
 
