@@ -9,6 +9,7 @@ profile = 1 - rliable's ``mean(e > tau)``, optimality gap = gamma x rliable's ga
 from __future__ import annotations
 
 import io
+import itertools
 import json
 import math
 from pathlib import Path
@@ -239,6 +240,23 @@ def test_pairing_is_kept_across_controllers():
     dx, dy = (ag.stratified_draws(20, 5, 500, np.random.default_rng(k)) for k in (1, 2))
     unpaired = ag.bootstrap_replicates(ag.iqm, [s], dx) - ag.bootstrap_replicates(ag.iqm, [s], dy)
     assert np.count_nonzero(unpaired) > 400
+
+
+def test_paired_resampling_weights_matched_seeds_in_p_by_one_over_n():
+    """Exact mean over all N^N resamples of N = 3 seeds: E[P*] = P + (D - P) / N.
+
+    P counts every pair (i, j) of runs; a paired resample repeats seed k in X and in Y together, so
+    the matched pairs (k, k) weigh E[c_k^2] = 2 - 1/N instead of 1 (c_k: multinomial counts).  D is
+    the matched-seed rate mean_k([x_k < y_k] + [x_k = y_k] / 2).
+    """
+    x, y = np.array([[1.0], [4.0], [6.0]]), np.array([[2.0], [3.0], [7.0]])
+    p = ag.probability_of_improvement(x, y)
+    assert p == 5.0 / 9.0                                    # 1<2, 1<3, 1<7, 4<7, 6<7
+    d = 2.0 / 3.0                                            # 1<2, not 4<3, 6<7
+    draws = np.array(list(itertools.product(range(3), repeat=3))).T[None].transpose(0, 2, 1)
+    assert draws.shape == (1, 27, 3)
+    rep = ag.bootstrap_replicates(ag.probability_of_improvement, [x, y], draws)
+    assert rep.mean() == pytest.approx(p + (d - p) / 3.0, rel=1e-14)
 
 
 def test_reversed_pairs_are_complements():
