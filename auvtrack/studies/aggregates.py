@@ -27,8 +27,8 @@ statistics of the replicates (the inverse empirical CDF, NumPy's ``inverted_cdf`
 0.95 means 95 %), so infinite replicates are handled exactly; rliable interpolates linearly
 (through ``arch``), which is undefined between two infinities.
 
-Why written here rather than taken from rliable (version 1.2.0, August 2024, checked December
-2025): (1) rliable resamples every algorithm independently (``get_interval_estimates`` builds
+Why written here rather than taken from rliable (1.2.0, its latest release, August 2024):
+(1) rliable resamples every algorithm independently (``get_interval_estimates`` builds
 one bootstrap per algorithm; the probability of improvement resamples X and Y independently),
 which throws away the pairing of common random numbers; (2) its ``random_state`` argument has
 no effect (``StratifiedBootstrap.update_indices`` draws from NumPy's global generator), so a
@@ -36,7 +36,7 @@ seeded ``numpy.random.Generator`` cannot drive it; (3) it pulls in ``arch`` (pin
 with statsmodels), seaborn and absl-py, and a fresh install (arch 7.2.0 with pandas 3) fails at
 import.  SciPy covers the pieces used here: ``scipy.stats.trim_mean`` (the IQM, as in rliable)
 and ``scipy.stats.rankdata`` (the U statistic, vectorised over replicates); ``scipy.stats.
-bootstrap`` has neither strata nor shared indices across samples and interpolates its
+bootstrap`` can pair samples (``paired=True``) but has no strata, and interpolates its
 quantiles.  ``tests/test_aggregates.py`` checks every statistic against rliable's formulas on
 hand-computed cases and against rliable's own numbers (``tests/data/rliable_reference.json``,
 written by ``benchmarks/rliable_reference.py``).
