@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from hypothesis import given, settings, strategies as hs
+from hypothesis import given, strategies as hs
 from hypothesis.extra import numpy as hnp
 from scipy import stats
 
