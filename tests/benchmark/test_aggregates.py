@@ -3,7 +3,7 @@
 rliable is not installed here: its numbers are in ``tests/data/rliable_reference.json``, written by
 ``benchmarks/rliable_reference.py`` in a throw-away environment.  rliable counts higher scores as
 better; the conversions to errors (lower is better) are those of the module docstring of
-:mod:`auvtrack.studies.aggregates`: IQM, median and mean unchanged, P(X < Y) = rliable's P(-X > -Y),
+:mod:`auvtrack.benchmark.aggregates`: IQM, median and mean unchanged, P(X < Y) = rliable's P(-X > -Y),
 profile = 1 - rliable's ``mean(e > tau)``, optimality gap = gamma x rliable's gap of 1/e at 1/gamma.
 """
 from __future__ import annotations
@@ -25,7 +25,7 @@ from auvtrack.studies import aggregates as ag
 from auvtrack.studies import aggregate_plots as ap
 
 INF = math.inf
-REF = json.loads((Path(__file__).parent / "data" / "rliable_reference.json").read_text())
+REF = json.loads((Path(__file__).resolve().parents[1] / "data" / "rliable_reference.json").read_text())
 
 
 def _arr(rows) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Figures of the aggregates across tasks (:mod:`auvtrack.studies.aggregates`), for the benchmark report.
+"""Figures of the aggregates across tasks (:mod:`auvtrack.benchmark.aggregates`), for the benchmark report.
 
 Matplotlib ``Figure`` objects (no pyplot, as :mod:`auvtrack.studies.compare_report`): performance
 profiles with their bootstrap bands, probabilities of improvement with their intervals, and
@@ -39,7 +39,7 @@ def figure_performance_profiles(profiles: Mapping[str, Profile], *, xlabel: str 
     Parameters
     ----------
     profiles : mapping of str to Profile
-        From :func:`auvtrack.studies.aggregates.performance_profiles`.
+        From :func:`auvtrack.benchmark.aggregates.performance_profiles`.
     xlabel : str, optional
         Label of the tau axis.
     log_x : bool, optional
@@ -101,7 +101,7 @@ def figure_improvement_probabilities(probabilities: Mapping[tuple[str, str], Est
     Parameters
     ----------
     probabilities : mapping
-        ``{(X, Y): Estimate}`` from :func:`auvtrack.studies.aggregates.improvement_probabilities`.
+        ``{(X, Y): Estimate}`` from :func:`auvtrack.benchmark.aggregates.improvement_probabilities`.
     pairs : sequence of (str, str), optional
         Pairs to show, top to bottom (default: each unordered pair once, as given).
 
@@ -144,7 +144,7 @@ def figure_aggregate_intervals(estimates: AggregateEstimates, *, aggregates: Seq
     Parameters
     ----------
     estimates : AggregateEstimates
-        From :func:`auvtrack.studies.aggregates.aggregate_estimates`.
+        From :func:`auvtrack.benchmark.aggregates.aggregate_estimates`.
     aggregates : sequence of str, optional
         Panels, left to right (default: every aggregate in ``estimates``).
     controllers : sequence of str, optional
