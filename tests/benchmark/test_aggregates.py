@@ -21,8 +21,8 @@ from hypothesis import given, strategies as hs
 from hypothesis.extra import numpy as hnp
 from scipy import stats
 
-from auvtrack.studies import aggregates as ag
-from auvtrack.studies import aggregate_plots as ap
+from auvtrack.benchmark import aggregates as ag
+from auvtrack.benchmark import aggregate_plots as ap
 
 INF = math.inf
 REF = json.loads((Path(__file__).resolve().parents[1] / "data" / "rliable_reference.json").read_text())
