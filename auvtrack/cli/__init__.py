@@ -12,14 +12,21 @@ these exit codes.
 """
 from __future__ import annotations
 
+import traceback
 import warnings
 
 import click
 
 from . import compare, perf, run, studies, sweep  # noqa: F401  (each registers its commands on the group)
-from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_SIM_FAILED, cli, one_line
+from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_SIM_FAILED, VERBOSE, cli, one_line
 
 __all__ = ["cli", "main", "EXIT_BAD_INPUT", "EXIT_SIM_FAILED", "EXIT_INTERRUPTED"]
+
+
+def _details(text: str) -> None:
+    """With ``--verbose``, the full report of an error after its one line."""
+    if VERBOSE["on"] and text:
+        click.echo(text.rstrip(), err=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -27,6 +34,7 @@ def main(argv: list[str] | None = None) -> int:
     from ..scenario import ScenarioError
 
     warnings.simplefilter("default")
+    VERBOSE["on"] = False
     try:
         rv = cli.main(args=argv, prog_name="auvtrack", standalone_mode=False)
     except click.exceptions.Exit as e:
@@ -37,12 +45,14 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     except click.ClickException as e:
         e.show()
+        _details(getattr(e, "details", ""))
         return e.exit_code
     except click.exceptions.Abort:  # Ctrl-C outside a simulation (loading, compiling, saving)
         click.echo("auvtrack: interrupted", err=True)
         return EXIT_INTERRUPTED
     except (ScenarioError, ValueError, KeyError, OSError) as e:
         click.echo(f"auvtrack: error: {one_line(e)}", err=True)
+        _details(getattr(e, "details", "") or "".join(traceback.format_exception(e)))
         return EXIT_BAD_INPUT
     # without standalone mode, click returns the code of a raised ``Exit`` instead of exiting
     return rv if isinstance(rv, int) else 0

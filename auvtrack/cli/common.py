@@ -13,10 +13,18 @@ MAX_REPEAT = 1000
 LONG_RUN_STEPS = 1_000_000  # runs this long announce themselves (and that Ctrl-C keeps their result)
 
 
+VERBOSE = {"on": False}
+"""Set by ``auvtrack --verbose``: an error also prints its full report."""
+
+
 class BadInput(click.ClickException):
-    """Any user error: shown as one line, exit status 2."""
+    """Any user error: shown as one line, exit status 2 (``details``: the full report for ``--verbose``)."""
 
     exit_code = EXIT_BAD_INPUT
+
+    def __init__(self, message: str, details: str = ""):
+        super().__init__(message)
+        self.details = details
 
     def show(self, file=None) -> None:  # noqa: D102 - one line, no "Error:" banner
         click.echo(f"auvtrack: error: {self.format_message()}", err=True)
@@ -35,7 +43,10 @@ def prepare_arg(scenario: str, sc):
     try:
         return prepare(sc)
     except ValueError as exc:  # ScenarioError of the plan, or a controller refusing its set-up
-        raise BadInput(f"{scenario}: {one_line(exc)}") from None
+        import traceback
+
+        raise BadInput(f"{scenario}: {one_line(exc)}",
+                       getattr(exc, "details", "") or "".join(traceback.format_exception(exc))) from None
 
 
 def mib(n: int) -> str:
@@ -81,7 +92,8 @@ class _Group(click.Group):
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="auvtrack")
-def cli() -> None:
+@click.option("--verbose", is_flag=True, help="On an error, also print its full report (traceback, compiler report).")
+def cli(verbose: bool) -> None:
     """auvtrack: trajectory-tracking control of underactuated AUVs.
 
     Scenarios are TOML files in which every key has a default (docs/scenarios.md); an empty
@@ -89,6 +101,7 @@ def cli() -> None:
     installing or editing the package compiles the Numba kernels (about a minute, more on a
     loaded machine; cached on disk afterwards); `auvtrack warmup` does that up front.
     """
+    VERBOSE["on"] = verbose
 
 
 set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",

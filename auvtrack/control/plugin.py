@@ -83,9 +83,10 @@ def spec_of(section: "Params") -> ControllerSpec:
     Returns
     -------
     ControllerSpec
-        The plug-in's record, its module the file or dotted name.
+        The plug-in's record (its capabilities), its module the file or dotted name, set up through
+        this loader (:func:`setup`: checks and a first call of the law).
     """
-    return load(section.module)[1]
+    return dataclasses.replace(load(section.module)[1], setup=setup, params=Params)
 
 
 def _numbers(model, data: dict, law: str) -> None:
@@ -159,10 +160,16 @@ def _probe(mod, law: str, cc: CompiledController, ctx: SetupContext) -> None:
     """Run the law once at the initial state, compiled with bounds checking: an int status, no bad index."""
     from numba import njit as numba_njit
 
+    from numba.core.errors import NumbaError
+
+    from ..jit.errors import CompileError, compile_error_line
+
     checked = numba_njit(boundscheck=True)(mod.control.py_func)
     try:
         status, _, _, _ = evaluate(checked, 0.0, ctx.eta0, ctx.nu0, cc.xc0, ctx.refm0, cc.cp, ctx.vp_nom,
                                    n_aux=len(cc.aux_names))
+    except NumbaError as exc:
+        raise CompileError(f"controller.module: {compile_error_line(str(exc), law)}", str(exc)) from None
     except Exception as exc:
         raise ValueError(f"controller.module: {law}: control fails at the initial state: {first_line(exc)}") from None
     if isinstance(status, (bool, np.bool_)) or not isinstance(status, (int, np.integer)):

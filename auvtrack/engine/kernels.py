@@ -38,12 +38,12 @@ from typing import Callable, Iterable, Sequence
 import numpy as np
 
 from .. import jit as _jit
+from ..jit.errors import CompileError, compile_error_line
 from ..user_modules import file_digest
 from ..user_modules import identifier as _ident
 from . import loop as engine
 
-__all__ = ["KernelKey", "kernel", "is_compiled", "warmup", "kernel_source",
-           "compile_estimate"]
+__all__ = ["KernelKey", "kernel", "is_compiled", "warmup", "kernel_source", "compile_estimate"]
 
 COMPILE_ESTIMATE_S = 20.0  # shown before the first compile of a kernel when nothing was measured yet
 
@@ -380,9 +380,14 @@ def compile_lanes(key: KernelKey) -> bool:
 
 
 def _compile_in_process(key: KernelKey, lanes: bool = False) -> float:
+    from numba.core.errors import NumbaError
+
     t0 = time.perf_counter()
     if not is_compiled(key):
-        _compile_run(kernel(key))
+        try:
+            _compile_run(kernel(key))
+        except NumbaError as exc:
+            raise CompileError(compile_error_line(str(exc), key.label or key.name), str(exc)) from None
         mark_compiled(key, time.perf_counter() - t0)
     if lanes and not is_compiled(key, lanes=True):
         compile_lanes(key)
@@ -480,7 +485,7 @@ def _compile_in_child(keys: list[KernelKey], bar, lanes: bool = False) -> None:
         err = errf.read()
     if rc != 0:
         names = ", ".join(k.label or k.name for k in keys)
-        raise RuntimeError(f"compiling {names} failed:\n{err.strip()}")
+        raise CompileError(compile_error_line(err, names), err.strip())
 
 
 def _child_compile(keys: list[KernelKey], lanes: bool = False) -> None:

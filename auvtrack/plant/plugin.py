@@ -101,7 +101,7 @@ def spec_of(section: Section) -> PlantSpec:
         The plug-in's record, its module the file or dotted name.
     """
     _, spec = load(section.module)
-    return dataclasses.replace(spec, module=section.module)
+    return dataclasses.replace(spec, module=section.module, setup=setup, section=Section)
 
 
 def setup(section: Section, ctx: PlantContext) -> CompiledPlant:

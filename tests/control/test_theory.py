@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from auvtrack.control.fxtntsmc import theory as th
-from auvtrack.control.gain_presets import FXTNTSMCParams
+from auvtrack.control.fxtntsmc import Params as FXTNTSMCParams
 
 SECTION4 = dict(kappa1=0.005, kappa2=0.8, kappa3=0.6, a1=0.8, a3=0.8, a2=0.8, a4=2.0, alpha=0.6,
                 sigma=0.005, varsigma1=0.05)

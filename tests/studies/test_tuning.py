@@ -40,7 +40,7 @@ def test_gain_space_round_trip_and_theorem1_box():
     fx = tuning.SPACES["fxtntsmc"]
     # every corner of the FXTNTSMC box satisfies Theorem 1 (kappa3 > 0.5, alpha window)
     from itertools import product
-    from auvtrack.control.gain_presets import FXTNTSMCParams
+    from auvtrack.control.fxtntsmc import Params as FXTNTSMCParams
     for corner in product(*fx.bounds):
         assert check_theorem1(FXTNTSMCParams(**dict(zip(fx.names, corner)))) == []
 
