@@ -137,6 +137,10 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         raise BadInput(f"{'--out' if out is not None else 'run folder'}: {_one_line(exc)}") from None
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
+    if not sc.controller.kind.startswith("open_loop"):  # a reference the plant cannot fly: say so, fly anyway
+        from .plant.feasibility import assess
+        if (line := assess(sc).warning()) is not None:
+            click.echo(f"warning: {line}", err=True)
     ensure_compiled([prep])  # compile or load the kernel first: Ctrl-C from here on stops the simulation
     if prep.n_steps >= LONG_RUN_STEPS:
         click.echo(f"running {prep.n_steps} RK4 steps (Ctrl-C stops the run and keeps its partial result)", err=True)
@@ -167,7 +171,8 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
     """Validate SCENARIO and its --set overrides as run would (load, plan, controller set-up), without simulating.
 
-    Warns where Theorem 1's conditions fail.
+    Warns where Theorem 1's conditions fail, and prints whether the plant can fly the reference
+    (trim, surge, tightest turn against the limits; docs/vehicles.md#feasibility).
     """
     from .scenario.plan import plan_run
 
@@ -184,6 +189,9 @@ def check(scenario: str, overrides: tuple[str, ...]) -> None:
     click.echo(f"ok: {scenario} ({sc.name}: controller {sc.controller.kind}, "
                f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s: {plan.n_steps} steps, {plan.log_rows} logged rows, "
                f"~{_mib(plan.memory_bytes)})")
+    from .plant.feasibility import assess
+
+    click.echo(assess(sc).summary())
 
 
 @cli.command()

@@ -63,6 +63,10 @@ API = [
     "auvtrack.studies.leaderboard.paired_comparisons",
     "auvtrack.runner.compare.execute",
     "auvtrack.runner.compare.run_chunk",
+    "auvtrack.plant.feasibility.assess.assess",
+    "auvtrack.plant.feasibility.steady.tightest_turn",
+    "auvtrack.plant.feasibility.demands.reference_demands",
+    "auvtrack.plant.feasibility.demands.current_bound",
 ]
 
 
