@@ -403,6 +403,12 @@ def test_check_prints_the_assessment_and_run_warns_in_one_line(tmp_path):
             assert lines[0].startswith("warning: feasibility: infeasible: stern plane, straight")
 
 
+def test_the_numbers_in_the_docs_are_the_codes():
+    from auvtrack.plant.feasibility import doc
+    text = doc.DOC.read_text()
+    assert doc.render_text(text) == text, "python -m auvtrack.plant.feasibility.doc render"
+
+
 def test_api_and_bad_input_are_one_line():
     assert auvtrack.feasibility is assess
     with pytest.raises(ValueError, match=r"^sigmas: must be a finite number >= 0 \(got -1\)$"):

@@ -3,7 +3,7 @@
 A *steady state* at speed U through the water, depth rate z_dot and signed horizontal curvature
 kappa (1/m, positive turning to starboard) is a constant body velocity, constant roll and pitch
 and a constant heading rate psi_dot = kappa U_h, U_h = sqrt(U^2 - z_dot^2) the horizontal speed,
-with the inputs that hold it (Fossen 2021, Section 16.1 on steady turning; the trim is kappa = 0).
+with the inputs that hold it (Fossen 2021, ch. 6, the steady turn of a manoeuvring model; the trim is kappa = 0).
 Each plant kind implements :class:`SteadyModel` (:mod:`auvtrack.plant.feasibility.steady5`,
 :mod:`auvtrack.plant.feasibility.steady6`); this module holds what they share:
 
@@ -18,7 +18,7 @@ Each plant kind implements :class:`SteadyModel` (:mod:`auvtrack.plant.feasibilit
 References
 ----------
 Fossen, T. I. (2021). Handbook of Marine Craft Hydrodynamics and Motion Control, 2nd ed., Wiley,
-Section 16.1 (manoeuvring: steady turning, turning circle), ch. 11 (actuator limits).
+ch. 6 (maneuvering models: steady turning, the turning circle), ch. 8 (models for underwater vehicles).
 """
 from __future__ import annotations
 

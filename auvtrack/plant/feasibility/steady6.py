@@ -13,7 +13,7 @@ the engine integrates)::
     d psi/dt = kappa U_h         (1)  heading rate of a horizontal circle of curvature kappa,
                                       U_h = |(dx/dt, dy/dt)|
 
-11 equations in 11 unknowns (Fossen 2021, Section 16.1: a steady turn has constant nu and
+11 equations in 11 unknowns (Fossen 2021, ch. 6: a steady turn has constant nu and
 constant roll and pitch; the trim is kappa = 0, where p = q = r = 0 follows).  The fin and
 propeller limits are lifted while solving (so the required angle is found even beyond the
 limit) and compared afterwards with the preset's (with the scenario's ``[plant]`` overrides):
@@ -22,7 +22,7 @@ the usage of each limit is |delta| / delta_max, |n| / n_max, |theta| / theta_lim
 
 In a current the model's hydrodynamics act on the velocity relative to the water, so these
 still-water states are the water-relative ones (Prestero's model: exactly, Fossen 2021
-Property 10.1 for a constant irrotational current; Fossen's: except that its propeller's advance
+ch. 10 for a constant irrotational current, tested; Fossen's: except that its propeller's advance
 speed is the speed over ground (PVS), which the still-water state takes equal to U).
 """
 from __future__ import annotations
