@@ -228,7 +228,8 @@ def _flight(speed_h: float, depth_rate: float) -> tuple[float, float]:
 
 
 def _where(speed: float, depth_rate: float) -> str:
-    return f"{_num(speed)} m/s through the water, depth rate {'+' if depth_rate >= 0 else '-'}{_num(abs(depth_rate))} m/s"
+    sign = "+" if depth_rate >= 0 else "-"
+    return f"{_num(speed)} m/s through the water, depth rate {sign}{_num(abs(depth_rate))} m/s"
 
 
 def trim_checks(model: SteadyModel, pts: WaterPoints, marginal: float = MARGINAL_FRACTION) -> list[Check]:

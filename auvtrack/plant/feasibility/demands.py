@@ -39,8 +39,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ...reference import Reference
 
 SAMPLE_DT = 0.05           # s between reference samples (bounded by MIN/MAX_SAMPLES)
 MIN_SAMPLES, MAX_SAMPLES = 201, 20001
@@ -69,7 +73,11 @@ def horizontal_curvature(velocity: np.ndarray, acceleration: np.ndarray) -> np.n
         return np.where(uh > SPEED_EPS, cross / np.maximum(uh, SPEED_EPS) ** 3, 0.0)
 
 
-def water_relative(speed_h, accel_t, accel_n, current_h, beta):
+ArrayLike = float | np.ndarray
+
+
+def water_relative(speed_h: ArrayLike, accel_t: ArrayLike, accel_n: ArrayLike, current_h: float,
+                   beta: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Water-relative horizontal speed and curvature, eq. (2) and (3).
 
     Parameters
@@ -142,12 +150,13 @@ def check_sigmas(sigmas: float) -> float:
     ValueError
         ``sigmas: must be a finite number >= 0 (got ...)``.
     """
-    if isinstance(sigmas, bool) or not isinstance(sigmas, (int, float)) or not (math.isfinite(sigmas) and sigmas >= 0):
+    number = isinstance(sigmas, (int, float)) and not isinstance(sigmas, bool)
+    if not (number and math.isfinite(sigmas) and sigmas >= 0):
         raise ValueError(f"sigmas: must be a finite number >= 0 (got {sigmas!r})")
     return float(sigmas)
 
 
-def current_bound(disturbances, sigmas: float = CURRENT_SIGMAS) -> CurrentBound:
+def current_bound(disturbances: Sequence[Mapping], sigmas: float = CURRENT_SIGMAS) -> CurrentBound:
     """The worst-case current of the scenario's ``[[disturbance]]`` list.
 
     Parameters
@@ -174,7 +183,7 @@ def current_bound(disturbances, sigmas: float = CURRENT_SIGMAS) -> CurrentBound:
                         mean=tuple(float(x) for x in mean), sigma=tuple(float(x) for x in sd))
 
 
-def sample_times(reference, duration: float) -> np.ndarray:
+def sample_times(reference: Reference, duration: float) -> np.ndarray:
     """Times at which the reference is evaluated on [0, duration]: a uniform grid, the joints and their midpoints.
 
     Parameters
@@ -234,7 +243,10 @@ class ReferenceDemands:
         return horizontal_curvature(self.velocity, self.acceleration)
 
     def path_accelerations(self) -> tuple[np.ndarray, np.ndarray]:
-        """(a_t, a_n): tangential and starboard-normal horizontal accelerations, m/s^2 (a_t = |a_h|, a_n = 0 where U_h = 0)."""
+        """(a_t, a_n): tangential and starboard-normal horizontal accelerations, m/s^2.
+
+        Where U_h = 0 the tangent is taken as north.
+        """
         v, a = self.velocity, self.acceleration
         uh = self.horizontal_speed
         moving = uh > SPEED_EPS
@@ -246,13 +258,15 @@ class ReferenceDemands:
         """One phrase for reports: speed and depth-rate ranges, tightest ground radius."""
         def rng(x, unit):
             lo, hi = float(np.min(x)), float(np.max(x))
-            return f"{lo:.3g} {unit}" if math.isclose(lo, hi, rel_tol=1e-6, abs_tol=1e-9) else f"{lo:.3g} to {hi:.3g} {unit}"
+            if math.isclose(lo, hi, rel_tol=1e-6, abs_tol=1e-9):
+                return f"{lo:.3g} {unit}"
+            return f"{lo:.3g} to {hi:.3g} {unit}"
         k = np.max(np.abs(self.curvature))
         turn = "no turn" if k == 0.0 else f"tightest radius {1.0 / k:.3g} m"
         return f"speed over ground {rng(self.speed, 'm/s')}, depth rate {rng(self.depth_rate, 'm/s')}, {turn}"
 
 
-def reference_demands(reference, duration: float) -> ReferenceDemands:
+def reference_demands(reference: Reference, duration: float) -> ReferenceDemands:
     """Sample the reference's velocity and acceleration over [0, duration].
 
     Parameters

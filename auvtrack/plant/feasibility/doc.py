@@ -35,8 +35,8 @@ def prestero_trim_rows() -> list[str]:
         s = m.solve(u, 0.0, 0.0)
         name, use = s.worst
         rows.append(f"| {u:g} | {_fmt(s.inputs['delta_s'])} | {_fmt(s.inputs['rpm'], 4)} | "
-                    f"{_fmt(s.inputs['pitch'])} | {_fmt(s.inputs['roll'])} | {status_of(use)} ({m.limits[name].label}, "
-                    f"{use:.0%}) |")
+                    f"{_fmt(s.inputs['pitch'])} | {_fmt(s.inputs['roll'])} | "
+                    f"{status_of(use)} ({m.limits[name].label}, {use:.0%}) |")
     return rows
 
 
@@ -44,7 +44,10 @@ SCAN = (0.4, 2.0, 0.01)   # m/s: the speeds at which Prestero's level trim is sc
 
 
 def prestero_fin_gaps() -> tuple[list[tuple[float, float]], float]:
-    """Speed intervals (m/s, on the :data:`SCAN` grid) where Prestero's level trim exceeds the stern-plane limit, and the limit (deg)."""
+    """Speed intervals (m/s) where Prestero's level trim exceeds the stern-plane limit, and that limit (deg).
+
+    Scanned on the :data:`SCAN` grid, each trim starting from the next faster one.
+    """
     from .steady6 import Steady6
     m = Steady6("remus100_prestero")
     lim = m.limits["delta_s"].available
@@ -80,7 +83,9 @@ def fossen_turn_rows() -> list[str]:
 
 
 def fossen_classic_diameter(speed: float = 1.0) -> tuple[float, float]:
-    """Steady diameter (m) and speed (m/s) of the classic turning circle: full rudder, stern plane 0, straight-trim rpm.
+    """Steady diameter (m) and speed (m/s) of Fossen's classic turning circle at ``speed``.
+
+    Full rudder, stern plane 0 and the propeller speed of straight flight at ``speed``.
 
     Simulated with the truth's reference integrator (600 s, dt 0.02 s) and measured as
     :func:`auvtrack.studies.manoeuvres.turning_circle_metrics` does.
@@ -100,7 +105,10 @@ def fossen_classic_diameter(speed: float = 1.0) -> tuple[float, float]:
 
 
 def current_case() -> tuple[float, float, float, str]:
-    """(demanded water radius, tightest radius (m), water speed (m/s), verdict) of the ground circle of :data:`CURRENT_CASE`."""
+    """The ground circle of :data:`CURRENT_CASE` through the water.
+
+    Returns (demanded water radius (m), tightest radius (m), water speed (m/s), verdict).
+    """
     from .assess import assess
     r, u, v = CURRENT_CASE
     f = assess({"reference": {"kind": "circle", "radius": r, "omega": u / r, "depth": 10.0},
@@ -118,7 +126,8 @@ def block() -> str:
     req, avail, uw, verdict = current_case()
     r, ug, v = CURRENT_CASE
     lines = ["`remus100_prestero`, level straight flight (trim of the truth, preset limits):", "",
-             "| speed (m/s) | stern plane (deg) | propeller (rpm) | pitch (deg) | roll (deg) | status (most used limit) |",
+             "| speed (m/s) | stern plane (deg) | propeller (rpm) | pitch (deg) | roll (deg) "
+             "| status (most used limit) |",
              "|---|---|---|---|---|---|", *prestero_trim_rows(), "",
              f"The level trim needs more stern plane than the {_fmt(lim)} deg limit from {where} (scanned from "
              f"{SCAN[0]:g} to {SCAN[1]:g} m/s every {SCAN[2]:g} m/s). As the speed falls the trim flies nose down at "
