@@ -24,6 +24,7 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
     second run never overwrites the first; the folder is printed.  The folder is checked before
     the simulation starts, and scenario.toml reproduces the run (auvtrack run <folder>/scenario.toml).
     """
+    from ..control import spec_for
     from ..simulation.compiling import ensure_compiled
     from ..simulation.pipeline import SimulationInterrupted, run_prepared
     from ..simulation.result import FolderError, prepare_run_folder
@@ -38,6 +39,11 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         raise BadInput(f"{'--out' if out is not None else 'run folder'}: {one_line(exc)}") from None
     for note in prep.notes:
         click.echo(f"warning: {note}", err=True)
+    if spec_for(sc.controller).tracks:  # a reference the plant cannot fly: say so, fly anyway
+        from ..feasibility import assess
+
+        if (line := assess(sc).warning()) is not None:
+            click.echo(f"warning: {line}", err=True)
     ensure_compiled([prep])  # compile or load the kernel first: Ctrl-C from here on stops the simulation
     if prep.n_steps >= LONG_RUN_STEPS:
         click.echo(f"running {prep.n_steps} RK4 steps (Ctrl-C stops the run and keeps its partial result)", err=True)
@@ -68,7 +74,8 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
 def check(scenario: str, overrides: tuple[str, ...]) -> None:
     """Validate SCENARIO and its --set overrides as run would (load, plan, controller set-up), without simulating.
 
-    Warns where the controller's own conditions fail (the FXTNTSMC: Theorem 1).
+    Warns where the controller's own conditions fail (the FXTNTSMC: Theorem 1), and prints whether the
+    plant can fly the reference (trim, surge, tightest turn against the limits; docs/vehicles.md#feasibility).
     """
     from ..control import spec_for
     from ..scenario.plan import plan_run
@@ -84,6 +91,9 @@ def check(scenario: str, overrides: tuple[str, ...]) -> None:
     click.echo(f"ok: {scenario} ({sc.name}: controller {sc.controller.kind}, "
                f"{sc.sim.duration:g} s at dt {sc.sim.dt:g} s: {plan.n_steps} steps, {plan.log_rows} logged rows, "
                f"~{mib(plan.memory_bytes)})")
+    from ..feasibility import assess
+
+    click.echo(assess(sc).summary())
 
 
 @cli.command()

@@ -63,6 +63,10 @@ API = [
     "auvtrack.benchmark.leaderboard.paired_comparisons",
     "auvtrack.benchmark.execute.execute",
     "auvtrack.benchmark.execute.run_chunk",
+    "auvtrack.feasibility.assess.assess",
+    "auvtrack.feasibility.steady.tightest_turn",
+    "auvtrack.feasibility.demands.reference_demands",
+    "auvtrack.feasibility.demands.current_bound",
 ]
 
 
