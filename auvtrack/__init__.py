@@ -7,7 +7,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-__all__ = ["__version__", "simulate", "load_scenario", "Result", "feasibility"]
+__all__ = ["__version__", "simulate", "load_scenario", "Result"]
 
 
 def __getattr__(name):  # lazy: importing auvtrack must not compile anything
@@ -19,10 +19,6 @@ def __getattr__(name):  # lazy: importing auvtrack must not compile anything
         from .scenario import load_scenario
 
         return load_scenario
-    if name == "feasibility":
-        from .feasibility import assess
-
-        return assess
     if name == "Result":
         from .simulation.result import Result
 

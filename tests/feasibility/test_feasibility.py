@@ -398,7 +398,7 @@ def test_check_prints_the_assessment_and_run_warns_in_one_line(tmp_path):
         pass
     for args, warned in ((sets, True), ([], False)):
         err = io.StringIO()
-        with mock.patch("auvtrack.simulation.pipeline.ensure_compiled"), \
+        with mock.patch("auvtrack.simulation.compiling.ensure_compiled"), \
                 mock.patch("auvtrack.simulation.pipeline.run_prepared", side_effect=Ran), \
                 contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err), pytest.raises(Ran):
             main(["run", str(REMUS), "--out", str(tmp_path / "r"), *args])  # the run still starts
@@ -415,7 +415,9 @@ def test_the_numbers_in_the_docs_are_the_codes():
 
 
 def test_api_and_bad_input_are_one_line():
-    assert auvtrack.feasibility is assess
+    from auvtrack import feasibility
+
+    assert feasibility.assess is assess
     with pytest.raises(ValueError, match=r"^sigmas: must be a finite number >= 0 \(got -1\)$"):
         assess({}, sigmas=-1)
     with pytest.raises(ValueError, match=r"^marginal: must be a number in \(0, 1\] \(got 0\)$"):
