@@ -121,9 +121,10 @@ The loop is a copy of auvtrack/engine/loop.py's kernel parts with ``law`` and ``
 {_comment(key.label or key.name)}
 from auvtrack.jit import llvm_inline, njit, njit_noalloc  # noqa: F401
 from auvtrack.engine.loop import *  # noqa: F401,F403
+from auvtrack.plant.contract import with_sizes
 from auvtrack.user_modules import load_module
 
-plant = load_module({key.plant!r})
+plant = with_sizes(load_module({key.plant!r}))
 law = llvm_inline(load_module({key.law!r}).control)  # one compilation, inlined by LLVM where called
 '''
     tail = "\n\nlog_row.lane_stub = True  # the SIMD batch kernels keep no trajectory (metrics only)\n"

@@ -34,6 +34,25 @@ SCRATCH_SIZE = 16  # length of the scratch array ``scr`` kept between a plant's 
 NX = N_CMD = N_LOG = 0  # a plant module's own (len(STATE), len(COMMAND), len(LOG_NAMES))
 
 
+def with_sizes(module):
+    """``module`` with ``NX``, ``N_CMD`` and ``N_LOG`` set from its names when it does not define them.
+
+    Parameters
+    ----------
+    module : module
+        A plant module.
+
+    Returns
+    -------
+    module
+        The same module (the loop reads its sizes as constants).
+    """
+    for attr, names in (("NX", "STATE"), ("N_CMD", "COMMAND"), ("N_LOG", "LOG_NAMES")):
+        if not hasattr(module, attr) and hasattr(module, names):
+            setattr(module, attr, len(getattr(module, names)))
+    return module
+
+
 def pose(x):
     """(eta, nu): the 5-DOF projection of the state that controllers see.
 

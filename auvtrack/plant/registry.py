@@ -214,6 +214,9 @@ def check_plant(module: ModuleType) -> PlantSpec:
         raise ValueError(f"{where}: Section must be a pydantic model class (got {sec!r})")
     if not callable(module.setup) or len(inspect.signature(module.setup).parameters) != 2:
         raise ValueError(f"{where}: setup must be a function setup(section, ctx)")
+    from .contract import with_sizes
+
+    with_sizes(module)
     for attr, size in (("NX", len(state)), ("N_CMD", len(command)), ("N_LOG", len(module.LOG_NAMES))):
         if getattr(module, attr, size) != size:
             raise ValueError(f"{where}: {attr} = {getattr(module, attr)!r} differs from the names it counts ({size})")

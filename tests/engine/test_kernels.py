@@ -37,7 +37,7 @@ def test_every_kernel_part_is_copied_verbatim_under_its_decorator():
         body = "\n".join(inspect.getsource(getattr(engine, name)).splitlines()[1:])
         assert f"@{decorator}\n{body}" in src
     assert "law = llvm_inline(load_module('auvtrack.control.ftsmc').control)" in src
-    assert "plant = load_module('auvtrack.plant.five_dof')" in src
+    assert "plant = with_sizes(load_module('auvtrack.plant.five_dof'))" in src
 
 
 def test_each_pair_has_its_own_kernel_and_module():

@@ -1,0 +1,89 @@
+"""A plant from outside the package (examples/plugin_plant.py: a 3-DOF horizontal-plane vehicle),
+flown by a built-in controller: it reproduces the horizontal motion of the 5-DOF plant, its
+contract is checked with one-line errors, and check and run refuse the same."""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import auvtrack
+from auvtrack.cli import EXIT_BAD_INPUT, main
+from auvtrack.plant.registry import check_plant
+from auvtrack.scenario import ScenarioError, load_scenario
+from auvtrack.user_modules import load_module
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "plugin_plant.py"
+BASE = {"vehicle": {"preset": "paper"}, "disturbance": [], "uncertainty": {"C": 0.0, "D": 0.0},
+        "reference": {"kind": "circle", "radius": 20.0, "omega": 0.05, "depth": 5.0},
+        "controller": {"kind": "pid"}, "sim": {"duration": 20.0, "dt": 0.01, "log_dt": 0.1},
+        "initial": {"eta": [19.0, 0.0, 5.0, 0.0, 1.5707963], "nu": [1.0, 0.0, 0.0, 0.0, 0.0]}}
+
+
+@pytest.fixture
+def plant_file(tmp_path) -> Path:
+    """The example copied to a folder outside the repository."""
+    path = tmp_path / "elsewhere" / "my_plant.py"
+    path.parent.mkdir()
+    shutil.copy(EXAMPLE, path)
+    return path
+
+
+def test_a_3dof_plug_in_plant_flies_the_horizontal_motion_of_the_5dof_plant(plant_file):
+    """Level flight at constant depth: the 5-DOF plant's horizontal equations are the plug-in's, so a
+    PID run on each gives the same horizontal trajectory and input (to rounding)."""
+    five = auvtrack.simulate(BASE)
+    three = auvtrack.simulate({**BASE, "plant": {"model": "plugin", "module": str(plant_file)}})
+    assert five.ok and three.ok
+    assert three.scenario["plant"] == {"model": "plugin", "module": str(plant_file), "params": {}}
+    for c in ("x", "y", "psi", "u", "v", "r", "tau_u", "tau_r"):
+        scale = 1.0 + np.max(np.abs(five[c]))
+        assert np.max(np.abs(five[c] - three[c])) <= 1e-9 * scale, c
+    assert np.all(three["z"] == 5.0) and np.all(three["theta"] == 0.0)
+    assert five.metrics["rmse_x"] < 0.2  # and it tracks
+
+
+def test_the_plug_in_plant_limits_what_it_applies(plant_file):
+    sc = {**BASE, "plant": {"model": "plugin", "module": str(plant_file), "params": {"tau_max": [5.0, 1.0]}}}
+    res = auvtrack.simulate(sc)
+    assert np.max(np.abs(res["tau_u"])) <= 5.0 and np.max(np.abs(res["tau_r"])) <= 1.0
+    assert res.metrics["t_sat_tau_u"] > 0
+
+
+def test_plug_in_plant_params_and_commands_are_checked_at_load(plant_file):
+    with pytest.raises(ScenarioError, match=r"plant\.params\.tau_max.*Section of"):
+        load_scenario({**BASE, "plant": {"model": "plugin", "module": str(plant_file), "params": {"tau_max": 3}}})
+    with pytest.raises(ScenarioError, match=r"controller\.kind: open_loop_actuators commands the actuators; "
+                                            r"plant\.model 'plugin' accepts tau"):
+        load_scenario({**BASE, "controller": {"kind": "open_loop_actuators"},
+                       "plant": {"model": "plugin", "module": str(plant_file)}})
+
+
+BROKEN = {
+    "no_setup": ("def setup(", "def not_setup(", r"does not define setup"),
+    "not_compiled": ("@njit_noalloc\ndef rhs(", "def rhs(", r"rhs must be compiled"),
+    "clashing_channel": ('LOG_NAMES = ()', 'LOG_NAMES = ("x",)', r"LOG_NAMES: channel name 'x' is taken"),
+    "repeated_state": ('STATE = ("x", "y", "z", "psi", "u", "v", "r")', 'STATE = ("x", "x", "z", "psi", "u", "v", "r")',
+                       r"STATE repeats a name"),
+    "actuators_only": ('ACCEPTS = ("tau",)', 'ACCEPTS = ("actuators",)', r"ACCEPTS must be"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BROKEN))
+def test_a_broken_plant_is_refused_in_one_line_naming_the_file(tmp_path, case):
+    old, new, expected = BROKEN[case]
+    text = EXAMPLE.read_text()
+    assert old in text
+    path = tmp_path / f"{case}.py"
+    path.write_text(text.replace(old, new))
+    with pytest.raises(ValueError, match=expected) as err:
+        check_plant(load_module(str(path)))
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+    # the command line refuses it the same way in check and run
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(f'[plant]\nmodel = "plugin"\nmodule = "{case}.py"\n')
+    assert main(["check", str(scenario)]) == EXIT_BAD_INPUT
+    assert main(["run", str(scenario), "--out", str(tmp_path / "run")]) == EXIT_BAD_INPUT
+    assert not (tmp_path / "run").exists()
