@@ -74,9 +74,10 @@ def control(t, eta, nu, att, xc, refm, vp, cp, tau, dxc, aux, work):
 
 def rudder_turn_sign(preset: str) -> float:
     """Sign of the yaw moment (hence of the heading change) a positive rudder angle gives on ``preset``."""
-    from ..plant.sixdof.truth import MODELS, pack_truth
-    model, pp = MODELS[preset], pack_truth(preset)
-    if preset == "remus100_prestero":
+    from ..plant.sixdof import prestero
+    from ..plant.sixdof.truth import model_of, pack_truth
+    model, pp = model_of(preset), pack_truth(preset)
+    if model is prestero:
         tr = model.produced(1.0, 0.1, 0.0, 0.0, pp)[2]
     else:
         tr = model.produced(1.0, 0.0, 0.0, 0.1, 0.0, 0.0, pp)[2]

@@ -10,6 +10,10 @@ from.  Registering a preset means adding its file: :func:`available` lists the f
   from the 6-DOF ``remus100_prestero`` data (``get_preset("remus100", u0=...)``; reduction in
   ``docs/vehicles.md``).
 
+A Fossen-type torpedo is reduced the same way by :mod:`auvtrack.plant.sixdof.torpedo_reduction`:
+the preset is then a vehicle file's path (``.toml``) or the name of a shipped Fossen-type 6-DOF
+file (:data:`TORPEDO_PRESETS`).
+
 :data:`SHIPPED` names them; a test checks that each one is present and valid.  Use :func:`get_preset` to read one and :func:`pack_vehicle` to build the packed ``vp``
 array of :mod:`auvtrack.plant.params`.
 """
@@ -27,6 +31,7 @@ from .params import CSCALE, D0, ELL, M0, VP_SIZE, WGML
 
 _FIELDS = ("m", "d", "wgml", "l")
 SHIPPED: tuple[str, ...] = ("paper", "remus100")
+TORPEDO_PRESETS: tuple[str, ...] = ("remus100_fossen", "remus600")  # shipped Fossen-type 6-DOF files
 
 
 @dataclass(frozen=True)
@@ -79,9 +84,36 @@ def _parsed(name: str) -> dict:
     return tomllib.loads((resources.files("auvtrack") / "data" / "vehicles" / f"{name}.toml").read_text())
 
 
+def torpedo_source(name: object) -> str | None:
+    """The vehicle file a 5-DOF preset name is reduced from: a ``.toml`` path itself, a shipped
+    Fossen-type file for a name of :data:`TORPEDO_PRESETS`, else None."""
+    from .sixdof.vehicle_file import is_vehicle_ref, shipped_dir
+
+    if is_vehicle_ref(name):
+        return str(name)
+    if name in TORPEDO_PRESETS:
+        return str(shipped_dir() / f"{name}.toml")
+    return None
+
+
 def is_reduced(name: str) -> bool:
-    """True for a preset computed from a 6-DOF model at a linearisation speed (e.g. ``remus100``)."""
-    return name in available() and "reduction_of" in _parsed(name)
+    """True for a preset computed from a 6-DOF model at a linearisation speed (e.g. ``remus100``, a vehicle file)."""
+    return torpedo_source(name) is not None or (name in available() and "reduction_of" in _parsed(name))
+
+
+def _torpedo_preset(name: str, u0: float | None) -> VehiclePreset:
+    """A Fossen-type torpedo's 5-DOF design model at ``u0`` (default: its file's ``design.u0``)."""
+    from .sixdof.torpedo_reduction import reduce_torpedo
+    from .sixdof.vehicle_file import label, load_vehicle_file
+
+    path = torpedo_source(name)
+    pr = load_vehicle_file(path)
+    speed = pr.values["design.u0"] if u0 is None else u0
+    red = reduce_torpedo(pr, speed, origin=name if name in TORPEDO_PRESETS else label(path))
+    l_src = pr.record["design"]["l"]
+    return VehiclePreset(name=name, description=f"{pr.description} (5-DOF reduction at U0)".strip(),
+                         m=red["m"], d=red["d"], wgml=red["wgml"], l=float(pr.values["design.l"]),
+                         sources={**red["sources"], "l": {"unit": "m", "source": l_src["source"]}}, u0=speed)
 
 
 def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
@@ -90,7 +122,8 @@ def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
     Parameters
     ----------
     name : str
-        Preset name, e.g. ``"paper"``.
+        Preset name, e.g. ``"paper"``, a name of :data:`TORPEDO_PRESETS` or the path of a
+        Fossen-type vehicle file (``.toml``).
     u0 : float, optional
         Linearisation speed (m/s) of a reduced preset (default: the file's ``u0``); refused for
         a preset stored as numbers.
@@ -105,10 +138,14 @@ def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
     KeyError
         If there is no such preset (the message names the available ones).
     ValueError
-        ``u0`` given for a preset that is not reduced, or out of range.
+        ``u0`` given for a preset that is not reduced, or out of range; a vehicle file that
+        breaks its rules (the message names the file and the field).
     """
+    if torpedo_source(name) is not None:
+        return _torpedo_preset(name, u0)
     if name not in available():
-        raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available()}")
+        raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available()}, "
+                       f"{', '.join(TORPEDO_PRESETS)} or a vehicle file (.toml)")
     raw = copy.deepcopy(_parsed(name))  # callers own what they get
     if "reduction_of" in raw:
         from .reduction import reduce_prestero  # a reduced preset: numbers from its 6-DOF data

@@ -17,10 +17,11 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, field_v
 from ..control import CONTROLLERS
 from ..control.params import FXTNTSMCParams, available_gain_presets, get_gain_preset
 from ..environment.current import MAX_SAMPLES as MAX_CURRENT_SAMPLES
-from ..plant.presets import available, get_preset, is_reduced
-from ..plant.sixdof.presets import available6, load_preset6
+from ..plant.presets import TORPEDO_PRESETS, available, get_preset, is_reduced
+from ..plant.sixdof.presets import available6
 from ..plant.reduction import U0_MAX, U0_MIN, default_u0
-from ..plant.sixdof.truth import actuator_values
+from ..plant.sixdof.truth import actuator_values, truth_preset
+from ..plant.sixdof.vehicle_file import is_vehicle_ref, resolve_path
 from ..reference import build_reference
 
 DEFAULT_PLANT_PRESET = "remus100_prestero"
@@ -167,7 +168,8 @@ class VehicleSection(_Section):
     number's source.
     """
 
-    preset: Str = Field("paper", description="one of auvtrack.plant.presets.available()")
+    preset: Str = Field("paper", description="one of auvtrack.plant.presets.available(), a shipped Fossen-type "
+                                             "torpedo (remus100_fossen, remus600) or a vehicle file (.toml)")
     m: Mass5 | None = Field(None, description="m11, m22, m33 (kg), m44, m55 (kg m^2)")
     d: Coefficient5 | None = Field(None, description="d11, d22, d33 (N s/m), d44, d55 (N m s/rad)")
     wgml: Coefficient | None = Field(None, description="rho g nabla GM_L, N m")
@@ -188,16 +190,25 @@ class VehicleSection(_Section):
         if not isinstance(name, str):
             raise ValueError(f"preset: must be a string (got {format_value(name)})")
         names = available()
-        if name not in names:
-            raise ValueError(f"preset: unknown preset (allowed: {', '.join(names)}) (got {name!r})")
+        if is_vehicle_ref(name):  # a vehicle file: relative to the working directory (a scenario
+            name = resolve_path(name)  # file's own paths are made relative to it by the loader)
+        elif name not in names and name not in TORPEDO_PRESETS:
+            raise ValueError(f"preset: unknown preset (allowed: {', '.join((*names, *TORPEDO_PRESETS))} "
+                             f"or a vehicle file .toml) (got {name!r})")
         # --- issue 11: a reduced preset is computed at vehicle.u0 (begin) ---
         u0 = data.get("u0")
         if u0 is not None and not is_reduced(name):
             raise ValueError(f"u0: only a reduced preset ({', '.join(n for n in names if is_reduced(n))}) "
                              f"has a linearisation speed; {name!r} has none (got {format_value(u0)})")
-        pre = get_preset(name, u0=u0 if isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX else None)
+        try:
+            pre = get_preset(name, u0=u0 if isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX else None)
+        except ValueError as exc:
+            if str(exc).startswith("vehicle.u0:"):
+                raise ValueError(str(exc).removeprefix("vehicle.")) from None
+            raise ValueError(f"preset: {exc}") from None
         # --- issue 11 (end) ---
         out = dict(data)
+        out["preset"] = name
         for key in _VEHICLE_FIELDS:
             if out.get(key) is None:
                 out[key] = getattr(pre, key)
@@ -325,7 +336,8 @@ class PlantSection(_Section):
     """
 
     model: Literal["5dof", "6dof"] = Field("5dof", description="'5dof' (paper eq. 1) or '6dof' (a truth preset)")
-    preset: Str | None = Field(None, description="6-DOF preset: remus100_prestero (default) or remus100_fossen")
+    preset: Str | None = Field(None, description="6-DOF preset: remus100_prestero (default), remus100_fossen, "
+                                                 "remus600, or a Fossen-type vehicle file (.toml)")
     delta_max: Annotated[Num, Field(gt=0, le=math.pi / 2)] | None = Field(None, description="fin angle limit, rad")
     n_max: Pos | None = Field(None, description="propeller speed limit, rpm")
     T_delta: Pos | None = Field(None, description="fin time constant, s")
@@ -343,6 +355,8 @@ class PlantSection(_Section):
     def _default_preset(cls, data: Any) -> Any:
         if isinstance(data, Mapping) and data.get("model") == "6dof" and data.get("preset") is None:
             return {**data, "preset": DEFAULT_PLANT_PRESET}
+        if isinstance(data, Mapping) and is_vehicle_ref(data.get("preset")):  # relative to the working directory
+            return {**data, "preset": resolve_path(data["preset"])}
         return data
 
     @model_validator(mode="after")
@@ -354,10 +368,15 @@ class PlantSection(_Section):
                                  f"(got {format_value(getattr(self, given[0]))} with model \"5dof\")")
             return self
         names = available6()
-        if self.preset not in names:
-            raise ValueError(f"preset: unknown 6-DOF preset (allowed: {', '.join(names)}) (got {self.preset!r})")
+        if self.preset not in names and not is_vehicle_ref(self.preset):
+            raise ValueError(f"preset: unknown 6-DOF preset (allowed: {', '.join(names)} or a vehicle file .toml) "
+                             f"(got {self.preset!r})")
         try:
-            actuator_values(load_preset6(self.preset), self.actuator_overrides())
+            pr = truth_preset(self.preset)[0]
+        except ValueError as exc:  # a vehicle file: "<file>: <section.key>: ..."
+            raise ValueError(f"preset: {exc}") from None
+        try:
+            actuator_values(pr, self.actuator_overrides())
         except ValueError as exc:  # "plant.<key>: ..." -> "<key>: ..."
             raise ValueError(str(exc).removeprefix("plant.")) from None
         return self
@@ -370,7 +389,7 @@ class PlantSection(_Section):
         """Effective actuator numbers of a 6-DOF plant (preset with overrides); None for 5dof."""
         if self.model != "6dof":
             return None
-        return actuator_values(load_preset6(self.preset), self.actuator_overrides())
+        return actuator_values(truth_preset(self.preset)[0], self.actuator_overrides())
 # --- issue 11 (end) ------------------------------------------------------------------------------
 
 
