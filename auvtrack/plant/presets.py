@@ -85,8 +85,11 @@ def _parsed(name: str) -> dict:
 
 
 def torpedo_source(name: object) -> str | None:
-    """The vehicle file a 5-DOF preset name is reduced from: a ``.toml`` path itself, a shipped
-    Fossen-type file for a name of :data:`TORPEDO_PRESETS`, else None."""
+    """The vehicle file a 5-DOF preset name is reduced from, or None.
+
+    A ``.toml`` path is its own file; a name of :data:`TORPEDO_PRESETS` is a shipped Fossen-type
+    6-DOF file.
+    """
     from .sixdof.vehicle_file import is_vehicle_ref, shipped_dir
 
     if is_vehicle_ref(name):

@@ -149,6 +149,11 @@ def trial_values(name: str) -> dict:
             "drift_dz": drift["dz"], "drift_dtheta": drift["dtheta"]}
 
 
+def _clean(x: float, tiny: float = 1e-6) -> float:
+    """``x`` with finite-difference and round-off noise below ``tiny`` shown as 0."""
+    return 0.0 if abs(x) < tiny else x
+
+
 def _ratio(model: float, trial: float) -> str:
     return fmt(model / trial, 2) + "×" if trial else "–"
 
@@ -164,7 +169,7 @@ def block_sea_trials() -> str:
         rows.append(f"| {what} | {fmt(pub, 3)} | {cells[0]} | {cells[1]} | {src} |")
     for key, what in (("drift_dz", "no fin step (drift over the same 2 s): depth change (m)"),
                       ("drift_dtheta", "no fin step: pitch change (deg)")):
-        rows.append(f"| {what} | – | {fmt(vals[TRUTHS[0]][key], 3)} | {fmt(vals[TRUTHS[1]][key], 3)} | "
+        rows.append(f"| {what} | – | {fmt(_clean(vals[TRUTHS[0]][key]), 3)} | {fmt(_clean(vals[TRUTHS[1]][key]), 3)} | "
                     "the truths' own motion in the stern-plane rows' interval |")
     return head + "\n" + "\n".join(rows)
 
@@ -248,7 +253,7 @@ def block_reduction() -> str:
     r = reduction_comparison()
     head = (f"At U₀ = {fmt(r['u0'], 3)} m/s (`remus100_fossen`; `tests/test_vehicle_file.py`):\n\n"
             "| generalized-force slope | truth (finite differences) | 5-DOF design model |\n|---|---|---|")
-    body = [f"| {what} | {fmt(a, 4)} | {fmt(b, 4)} |" for what, a, b in r["entries"]]
+    body = [f"| {what} | {fmt(_clean(a, 1e-9), 4)} | {fmt(_clean(b, 1e-9), 4)} |" for what, a, b in r["entries"]]
     tail = (f"\n\nLargest real part of the eigenvalues: truth {fmt(r['eig_truth'], 3)} 1/s, 5-DOF model "
             f"{fmt(r['eig_design'], 3)} 1/s. Surge response to a 1 % thrust step: the two agree to "
             f"{fmt(100 * r['surge_err'], 2)} % of the response over 30 s. Pitch- and yaw-rate responses to a "
@@ -294,9 +299,31 @@ def block_remus600() -> str:
             f"| ρg∇GM_L (N m), ℓ (m) | {fmt(v['wgml'], 4)}, {fmt(v['l'], 3)} | – |")
 
 
+def block_fields() -> str:
+    """Markdown table of every field of a vehicle file: unit, range, default, meaning (from ``FIELDS``)."""
+    from ..plant.sixdof.vehicle_file import DEFAULT_SOURCES, FIELDS
+
+    head = "| field | unit | allowed | if absent | meaning |\n|---|---|---|---|---|"
+    rows = []
+    for key, f in FIELDS.items():
+        allowed = f.range_text().removesuffix(f" {f.unit}") if f.unit else f.range_text()
+        if f.size > 1:
+            allowed = f"{f.size} numbers, each {allowed}"
+        if f.allow_inf:
+            allowed += " or inf"
+        if key in DEFAULT_SOURCES:
+            absent = fmt(f.default, 4)
+        elif key in ("hull.mass", "hull.buoyancy"):
+            absent = "neutral" if key == "hull.buoyancy" else "displaced mass"
+        else:
+            absent = "required"
+        rows.append(f"| `{key}` | {f.unit or '-'} | {allowed} | {absent} | {f.text} |")
+    return head + "\n" + "\n".join(rows)
+
+
 def blocks() -> dict:
     """Generated block name -> renderer (all in docs/vehicles.md)."""
-    return {"sea-trials": block_sea_trials, "truth-constants": block_constants,
+    return {"vehicle-file-fields": block_fields, "sea-trials": block_sea_trials, "truth-constants": block_constants,
             "torpedo-reduction": block_reduction, "remus600": block_remus600}
 
 
