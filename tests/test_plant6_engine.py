@@ -102,7 +102,7 @@ def test_current_acts_through_relative_velocity():
 
 def test_open_loop_actuator_bad_input():
     from auvtrack.scenario import ScenarioError
-    with pytest.raises(ScenarioError, match=r"controller.delta_r: beyond the actuator limit plant.delta_max = 0.261799"):
+    with pytest.raises(ScenarioError, match=r"controller.delta_r: beyond the actuator limit plant.delta_max = 0.237365"):
         load_scenario(REMUS, ["plant.model=6dof", "controller.kind=open_loop_actuators", "controller.delta_r=0.5"])
     with pytest.raises(ScenarioError, match=r"controller.rpm: beyond the actuator limit plant.n_max = 1525"):
         load_scenario(REMUS, ["plant.model=6dof", "controller.kind=open_loop_actuators", "controller.rpm=2000"])
