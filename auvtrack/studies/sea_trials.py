@@ -199,7 +199,7 @@ def block_constants() -> str:
             ("stern-plane pitch moment per u² δ_s (N m per (m/s)² rad)", "stern"),
             ("fin limit (deg)", "delta_max"), ("propeller limit (rpm)", "n_max"), ("mass (kg)", "mass")]
     head = "| constant | `remus100_prestero` | `remus100_fossen` | Fossen / Prestero |\n|---|---|---|---|"
-    body = [f"| {what} | {fmt(c[TRUTHS[0]][k], 3)} | {fmt(c[TRUTHS[1]][k], 3)} | "
+    body = [f"| {what} | {fmt(c[TRUTHS[0]][k], 4)} | {fmt(c[TRUTHS[1]][k], 4)} | "
             f"{fmt(c[TRUTHS[1]][k] / c[TRUTHS[0]][k], 3)} |" for what, k in rows]
     return head + "\n" + "\n".join(body)
 
