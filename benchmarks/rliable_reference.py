@@ -1,4 +1,4 @@
-"""rliable's own numbers on random data: the reference ``tests/test_aggregates.py`` checks against.
+"""rliable's own numbers on random data: the reference ``tests/benchmark/test_aggregates.py`` checks against.
 
 Usage (rliable is not a dependency of auvtrack; a throw-away virtual environment)::
 

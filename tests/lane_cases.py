@@ -1,6 +1,6 @@
 """Compiled functions exercising every construct of the lane rewrite (auvtrack.engine.lanes), for tests.
 
-Each is an ordinary compiled function of scalars; tests/test_simd.py checks that its lane form gives,
+Each is an ordinary compiled function of scalars; tests/engine/test_simd.py checks that its lane form gives,
 lane by lane, exactly the scalar function's results.
 """
 import math

@@ -1,4 +1,4 @@
-"""Evaluate the compiled FXTNTSMC law at seeded states; run as a script by tests/test_vecmath.py.
+"""Evaluate the compiled FXTNTSMC law at seeded states; run as a script by tests/engine/test_vecmath.py.
 
 ``python tests/law_points.py OUT.npz [IN.npz]`` writes the inputs and the law's outputs
 (status, tau, d/dt of the controller states, aux) at 3000 seeded states spread over the

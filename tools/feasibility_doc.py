@@ -1,9 +1,9 @@
 """The generated numbers of docs/vehicles.md, section "Feasibility", computed by the feasibility code.
 
-``python tools/feasibility_doc.py render`` rewrites the block between
+``python -m tools.feasibility_doc render`` rewrites the block between
 ``<!-- BEGIN GENERATED feasibility ... -->`` and ``<!-- END GENERATED feasibility -->``;
 ``... doc check`` exits with status 1 when the block differs from what the code gives
-(``tests/test_feasibility.py`` runs the same comparison).  Importing this module runs nothing.
+(``tests/feasibility/test_feasibility.py`` runs the same comparison).  Importing this module runs nothing.
 """
 from __future__ import annotations
 
@@ -150,7 +150,7 @@ def render_text(text: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python tools/feasibility_doc.py render | check``; returns the exit status."""
+    """``python -m tools.feasibility_doc render | check``; returns the exit status."""
     args = sys.argv[1:] if argv is None else argv
     old = DOC.read_text()
     if args == ["render"]:
@@ -158,10 +158,10 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args == ["check"]:
         if render_text(old) != old:
-            print(f"stale generated block in {DOC} (python tools/feasibility_doc.py render)")
+            print(f"stale generated block in {DOC} (python -m tools.feasibility_doc render)")
             return 1
         return 0
-    print("usage: python tools/feasibility_doc.py render | check", file=sys.stderr)
+    print("usage: python -m tools.feasibility_doc render | check", file=sys.stderr)
     return 2
 
 

@@ -13,7 +13,7 @@ output of the command that owns it (:data:`SOURCES`); nothing is typed by hand. 
     python -m tools.findings render   # rewrite the generated blocks
 
 ``python -m tools.findings check`` exits with status 1 when a generated block differs
-from what the stored results give (``tests/test_findings.py`` runs the same check).  A block
+from what the stored results give (``tests/docs/test_findings.py`` runs the same check).  A block
 sits between ``<!-- BEGIN GENERATED name ... -->`` and ``<!-- END GENERATED name -->``.
 
 This module is not a study (it defines no ``STUDY``); importing it runs nothing.

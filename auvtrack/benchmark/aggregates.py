@@ -37,7 +37,7 @@ with statsmodels), seaborn and absl-py, and a fresh install (arch 7.2.0 with pan
 import.  SciPy covers the pieces used here: ``scipy.stats.trim_mean`` (the IQM, as in rliable)
 and ``scipy.stats.rankdata`` (the U statistic, vectorised over replicates); ``scipy.stats.
 bootstrap`` can pair samples (``paired=True``) but has no strata, and interpolates its
-quantiles.  ``tests/test_aggregates.py`` checks every statistic against rliable's formulas on
+quantiles.  ``tests/benchmark/test_aggregates.py`` checks every statistic against rliable's formulas on
 hand-computed cases and against rliable's own numbers (``tests/data/rliable_reference.json``,
 written by ``benchmarks/rliable_reference.py``).
 
@@ -856,7 +856,7 @@ def improvement_probabilities(data, rng: np.random.Generator, *, score: str | No
     P counts every pair (i, j) of runs, of which the N matched pairs (same seed) weigh 1/N.  A
     paired resample repeats a seed in X and Y together, so on average the matched pairs weigh
     ``(2 - 1/N) / N``: the replicates are centred on ``P + (D - P) / N``, D the matched-seed rate
-    ``mean_k([x_k < y_k] + [x_k = y_k] / 2)`` (exact; ``tests/test_aggregates.py``).  With the
+    ``mean_k([x_k < y_k] + [x_k = y_k] / 2)`` (exact; ``tests/benchmark/test_aggregates.py``).  With the
     suite's 100 seeds the shift is at most 0.01; with ``--quick``'s 3 seeds it can move the
     interval off the point estimate.
 

@@ -52,7 +52,7 @@ class Params(ControllerParams):
     """Super-twisting sliding-mode control on s = e_dot + lam e (eq. S1-S5).
 
     ``L`` is the bound on |d chi / dt| that the gain condition is checked against (the
-    default holds on Section 4 with margin: ``tests/test_baselines.py`` measures it).
+    default holds on Section 4 with margin: ``tests/control/test_baselines.py`` measures it).
     """
 
     kind: Literal["sta"] = "sta"

@@ -15,7 +15,7 @@ calls, so these functions call it directly:
 
 libmvec's results are within 4 ulp of the correctly rounded value (glibc manual, "Errors in
 Math Functions"), so they can differ from the scalar libm in the last bits:
-``tests/test_vecmath.py`` pins each function to NumPy within 4 ulp, and the law using them to the
+``tests/engine/test_vecmath.py`` pins each function to NumPy within 4 ulp, and the law using them to the
 libm law within 1e-14 of each output's scale.  Without libmvec, without
 AVX2 on the compile target, or with ``AUVTRACK_LIBMVEC=0`` the same functions are scalar
 loops over libm (bit-identical to the code before this module).  :data:`BACKEND` names the
@@ -97,7 +97,7 @@ def _lane_signature(width: int, args) -> types.Type | None:
 WIDE_PAIRS = {"_ZGVdN4vv_pow": "_ZGVeN8vv_pow", "_ZGVdN4v_exp": "_ZGVeN8v_exp", "_ZGVdN4v_sin": "_ZGVeN8v_sin",
               "_ZGVdN4v_cos": "_ZGVeN8v_cos"}
 """4-lane AVX2 libmvec functions and their 8-lane AVX-512 forms that return the same bits (glibc 2.36,
-``tests/test_vecmath.py`` on 10^5 inputs each, specials included); the 8-lane ``atanh`` does not, so
+``tests/engine/test_vecmath.py`` on 10^5 inputs each, specials included); the 8-lane ``atanh`` does not, so
 it is not here.  Used by lane kernels of 8 runs (:mod:`auvtrack.jit.lane_values`): one call per 8 runs."""
 
 

@@ -20,7 +20,7 @@ DEPTH_STEP_WARN = 1.0
 
 Section 4 with a circle of radius 4 m at 0.1 rad/s, default start and gains: both controllers
 track a start 2 m above or below the circle, and stop at the pitch limit within 3 s from 2.5 m
-on (``tests/test_reference_start.py`` runs these cases).  The warning starts at half that, as a
+on (``tests/reference/test_reference_start.py`` runs these cases).  The warning starts at half that, as a
 margin for other gains, vehicles and references.
 """
 NOTE_PREFIX = "start: the virtual point starts"

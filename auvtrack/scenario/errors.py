@@ -119,6 +119,29 @@ def _fixed_length(annotation: Any) -> int | None:
     return None
 
 
+def _other_members_with(root: type[BaseModel], loc: tuple, parent: type[BaseModel] | None) -> list:
+    """For a key refused by one member of a discriminated union: [(tag field, this member's tag), (tag
+    field, tag) of each other member that has the key, ...]; empty when none has it or no union."""
+    if parent is None or len(loc) < 3:
+        return []
+    path: list = []
+    current: Any = root
+    for seg in loc[:-2]:  # down to the section holding the union
+        if not (isinstance(current, type) and issubclass(current, BaseModel)):
+            return []
+        field = current.model_fields.get(seg) if isinstance(seg, str) else None
+        current = _unwrap(field.annotation) if field is not None else None
+        path.append(seg)
+    members = _union_members(current) if current is not None else []
+    key = loc[-1]
+    mine = _kind_of(parent)
+    if not members or mine is None:
+        return []
+    tag = next(t for t in ("kind", "model") if t in parent.model_fields)
+    others = [(tag, _kind_of(m)) for m in members if m is not parent and key in m.model_fields and _kind_of(m)]
+    return [(tag, mine)] + others if others else []
+
+
 def _allowed_keys(model: type[BaseModel] | None) -> str:
     if model is None:
         return ""
@@ -132,6 +155,11 @@ def _describe(err: dict, root: type[BaseModel]) -> tuple[str, str]:
     got = f" (got {format_value(value)})"
     if etype == "extra_forbidden":
         _, parent = _walk(root, err["loc"][:-1])
+        owners = _other_members_with(root, err["loc"], _model(parent))
+        if owners:  # a key of another kind of the same section (a 6-DOF key with the 5-DOF plant)
+            tag, mine = owners[0]
+            where = " or ".join(f'{".".join(path[:-1] + [tag])} = "{kind}"' for _, kind in owners[1:])
+            return ".".join(path), f"only for {where} (got {format_value(value)} with {tag} \"{mine}\")"
         return ".".join(path), "unknown key" + _allowed_keys(_model(parent))
     if etype == "missing" and err["loc"] and isinstance(err["loc"][-1], int):  # short tuple
         parent_path, ann = _walk(root, err["loc"][:-1])

@@ -81,8 +81,10 @@ def _read_source(source: Source) -> tuple[str, dict[str, Any]]:
         return "<dict>", copy.deepcopy(dict(source))
     if isinstance(source, (str, os.PathLike)):
         from ..user_modules import anchor_module  # a plug-in path is relative to its scenario file
+        from ..vehicle.vehicle_file import anchor_vehicle_files  # so is a vehicle file's
 
-        return os.fspath(source), anchor_module(read_toml(source), Path(source).parent)
+        return os.fspath(source), anchor_vehicle_files(anchor_module(read_toml(source), Path(source).parent),
+                                                       Path(source).parent)
     raise ScenarioError(f"scenario source must be a TOML file path, a dict or a Scenario "
                         f"(got {type(source).__name__})")
 

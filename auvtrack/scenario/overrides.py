@@ -1,7 +1,8 @@
 """``dotted.key=value`` overrides applied to a raw scenario dict before validation.
 
 * ``sim.dt=0.002``: the value is parsed as a TOML value (numbers, booleans, strings, arrays,
-  inline tables, ``inf``); a bare word such as ``ftsmc`` is read as the string ``"ftsmc"``.
+  inline tables, ``inf``); a bare word such as ``ftsmc`` is read as the string ``"ftsmc"``, and so
+  is a bare ``.toml`` or ``.py`` file path such as ``../auvs/my_auv.toml``.
 * List entries are addressed by index: ``disturbance.0.amplitude=2``, ``initial.eta.1=0.7``;
   index ``len`` appends a new entry (``disturbance.1.kind=pulse``).
 * Kind switch: setting the ``kind`` of a section whose keys depend on it (``controller``,
@@ -26,6 +27,8 @@ Segment = str | int
 _SEGMENT = re.compile(r"^(?:[A-Za-z_][A-Za-z0-9_\-]*|\d+)$")
 # issue 11: a bare word may start with a digit when it has a letter (``plant.model=6dof``)
 _BARE_WORD = re.compile(r"^(?=.*[A-Za-z_])[A-Za-z0-9_][A-Za-z0-9_.\-+]*$")
+# a bare file path (a vehicle file, a plug-in): plant.preset=../auvs/my_auv.toml
+_BARE_PATH = re.compile(r"^[A-Za-z0-9_.~/\-+]+\.(?:toml|py)$")
 
 # Sections whose keys depend on ``kind`` (path without indices) and their default kind
 # (None: the kind is required).
@@ -78,7 +81,7 @@ def parse_value(text: str) -> Any:
     try:
         doc = tomllib.loads(f"v = {text}")
     except tomllib.TOMLDecodeError as exc:
-        if _BARE_WORD.match(text):
+        if _BARE_WORD.match(text) or _BARE_PATH.match(text):
             return text
         raise ValueError(f"not a TOML value ({exc})") from None
     if set(doc) != {"v"}:

@@ -19,12 +19,13 @@ from ..control import spec_for as controller_spec_for
 from ..control import fxtntsmc
 from ..control.gain_presets import available_gain_presets, get_gain_preset
 from ..environment.current import MAX_SAMPLES as MAX_CURRENT_SAMPLES
-from ..vehicle.presets import available, get_preset, is_reduced
+from ..vehicle.presets import available, contributed, get_preset, is_reduced
 from ..vehicle.reduction import U0_MAX, U0_MIN, default_u0
 from ..plant import PLANTS, five_dof
 from ..plant import spec_for as plant_spec_for
 from ..fields import (Bool, Coefficient, Coefficient5, Fraction, Int, Mass5, NonNeg, NonNeg5, Num, Open01, Pos, Pos3,
                       PosOrInf3, Range2, Str, Vec5, inf_words)
+from ..vehicle.vehicle_file import is_vehicle_ref, resolve_path
 from ..reference import build_reference
 from .components import check_disturbances, check_reference, jsonable
 from .errors import format_value
@@ -148,7 +149,8 @@ class VehicleSection(_Section):
     number's source.
     """
 
-    preset: Str = Field("paper", description="one of auvtrack.vehicle.presets.available()")
+    preset: Str = Field("paper", description="one of auvtrack.vehicle.presets.available(), a shipped Fossen-type "
+                                             "torpedo (remus100_fossen, remus600) or a vehicle file (.toml)")
     m: Mass5 | None = Field(None, description="m11, m22, m33 (kg), m44, m55 (kg m^2)")
     d: Coefficient5 | None = Field(None, description="d11, d22, d33 (N s/m), d44, d55 (N m s/rad)")
     wgml: Coefficient | None = Field(None, description="rho g nabla GM_L, N m")
@@ -167,14 +169,23 @@ class VehicleSection(_Section):
         if not isinstance(name, str):
             raise ValueError(f"preset: must be a string (got {format_value(name)})")
         names = available()
-        if name not in names:
-            raise ValueError(f"preset: unknown preset (allowed: {', '.join(names)}) (got {name!r})")
+        if is_vehicle_ref(name):  # a vehicle file: relative to the working directory (a scenario
+            name = resolve_path(name)  # file's own paths are made relative to it by the loader)
+        elif name not in names and name not in contributed():
+            raise ValueError(f"preset: unknown preset (allowed: {', '.join((*names, *contributed()))} "
+                             f"or a vehicle file .toml) (got {name!r})")
         u0 = data.get("u0")
         if u0 is not None and not is_reduced(name):
             raise ValueError(f"u0: only a reduced preset ({', '.join(n for n in names if is_reduced(n))}) "
                              f"has a linearisation speed; {name!r} has none (got {format_value(u0)})")
-        pre = get_preset(name, u0=u0 if isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX else None)
+        try:
+            pre = get_preset(name, u0=u0 if isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX else None)
+        except ValueError as exc:
+            if str(exc).startswith("vehicle.u0:"):
+                raise ValueError(str(exc).removeprefix("vehicle.")) from None
+            raise ValueError(f"preset: {exc}") from None
         out = dict(data)
+        out["preset"] = name
         for key in _VEHICLE_FIELDS:
             if out.get(key) is None:
                 out[key] = getattr(pre, key)
@@ -525,6 +536,13 @@ class Scenario(BaseModel):
     @classmethod
     def _disturbance(cls, v: Any) -> list:
         return check_disturbances(v)
+
+    @field_validator("plant", mode="before")
+    @classmethod
+    def _plant(cls, v: Any) -> Any:
+        if isinstance(v, Mapping) and "model" not in v:
+            return {**v, "model": five_dof.NAME}
+        return v
 
     @field_validator("controller", mode="before")
     @classmethod

@@ -134,6 +134,29 @@ def scenario_path(which: str):
     return resources.files("auvtrack") / "data" / "scenarios" / SCENARIOS[which]
 
 
+def rudder_within_limit(path, preset: str) -> list[str]:
+    """Override that puts a scenario's rudder at the truth ``preset``'s fin limit when it is beyond it, else none.
+
+    Parameters
+    ----------
+    path : path-like
+        A packaged manoeuvre scenario (valid with its own plant preset).
+    preset : str
+        The 6-DOF truth it is flown on.
+
+    Returns
+    -------
+    list of str
+        ``["controller.delta_r=<limit>"]`` (the scenario's sign) or ``[]``.
+    """
+    from ..plant.sixdof.truth import actuator_values, truth_preset
+    from ..scenario import load_scenario
+
+    lim = actuator_values(truth_preset(preset)[0])["delta_max"]
+    dr = load_scenario(path).controller.delta_r
+    return [f"controller.delta_r={math.copysign(lim, dr)!r}"] if abs(dr) > lim else []
+
+
 def run(out, *, quick: bool = False, progress: bool = False):
     """Run the turning circle and the zig-zag on both 6-DOF presets; write report, figures, results.
 
@@ -166,6 +189,7 @@ def run(out, *, quick: bool = False, progress: bool = False):
     for which in SCENARIOS:
         for preset in PRESETS:
             sets = [f"plant.preset={preset}"] + (["sim.duration=40"] if quick else [])
+            sets += rudder_within_limit(scenario_path(which), preset)
             sc = load_scenario(scenario_path(which), sets)
             res = run_prepared(prepare(sc))
             ch = res.channels
@@ -176,13 +200,15 @@ def run(out, *, quick: bool = False, progress: bool = False):
                 m = zigzag_metrics(ch["t"], ch["psi"], ch["delta_r"], sc.controller.zigzag_psi, t0)
             runs[(which, preset)] = (sc, ch)
             rows.append({"manoeuvre": which, "preset": preset, "status": res.status, **m,
+                         "delta_r_deg": math.degrees(abs(sc.controller.delta_r)),
                          "speed_end": float(ch["u"][-1]), "max_theta_deg": float(np.degrees(np.abs(ch["theta"]).max())),
                          "max_phi_deg": float(np.degrees(np.abs(ch["phi"]).max()))})
     write_json(out / "results.json", {"rows": rows, "quick": quick})
     rep = Report(out, "Manoeuvres of the REMUS 100 truth models: turning circle and zig-zag")
     rep.paragraph("Open-loop (controller `open_loop_actuators`), from straight running at 1.5 m/s with the "
                   "propeller trimmed; rudder put over at 5 s. Scenarios: `scenarios/remus100_turning_circle.toml`, "
-                  "`scenarios/remus100_zigzag.toml` (`--set plant.preset=...`). Metrics per ITTC 7.5-04-02-01. "
+                  "`scenarios/remus100_zigzag.toml` (`--set plant.preset=...`); the rudder at most at the "
+                  "preset's fin limit (P01: 13.6 deg). Metrics per ITTC 7.5-04-02-01. "
                   "P01's REMUS is open-loop unstable (docs/vehicles.md): it does not settle on a circle of the "
                   "rudder's making but spirals down, nose-down, losing speed.")
     fig = Figure(figsize=(10, 4.6))

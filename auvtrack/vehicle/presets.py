@@ -10,6 +10,11 @@ from.  Registering a preset means adding its file: :func:`available` lists the f
   from the 6-DOF ``remus100_prestero`` data (``get_preset("remus100", u0=...)``; reduction in
   ``docs/vehicles.md``).
 
+Other design models come from *preset sources* that plants register (:func:`register_source`):
+the 6-DOF truths contribute the reduction of a Fossen-type torpedo
+(:mod:`auvtrack.plant.sixdof.torpedo_reduction`), so that a preset may also be a vehicle file's path
+(``.toml``) or the name of a shipped Fossen-type 6-DOF file.  This package never imports a plant.
+
 :data:`SHIPPED` names them; a test checks that each one is present and valid.  Use :func:`get_preset` to read one and :func:`pack_vehicle` to build the packed ``vp``
 array of :mod:`auvtrack.vehicle.params`.
 """
@@ -19,6 +24,7 @@ import copy
 import functools
 import tomllib
 from dataclasses import dataclass
+from typing import Callable
 from importlib import resources
 
 import numpy as np
@@ -79,9 +85,58 @@ def _parsed(name: str) -> dict:
     return tomllib.loads((resources.files("auvtrack") / "data" / "vehicles" / f"{name}.toml").read_text())
 
 
+@dataclass(frozen=True)
+class PresetSource:
+    """A contributed family of design presets (e.g. the reductions of torpedo vehicle files).
+
+    Attributes
+    ----------
+    names : callable
+        ``names() -> tuple[str, ...]``: the shipped names it offers.
+    accepts : callable
+        ``accepts(name) -> bool``: whether a name (or a path) is one of its presets.
+    get : callable
+        ``get(name, u0) -> VehiclePreset``: the preset, reduced at ``u0`` (None: its default).
+    """
+
+    names: Callable[[], tuple[str, ...]]
+    accepts: Callable[[object], bool]
+    get: Callable[[str, float | None], "VehiclePreset"]
+
+
+SOURCES: list[PresetSource] = []
+"""Registered preset sources, asked in order after the shipped files."""
+
+
+def register_source(source: PresetSource) -> PresetSource:
+    """Add a source of design presets (:class:`PresetSource`).
+
+    Parameters
+    ----------
+    source : PresetSource
+        The source.
+
+    Returns
+    -------
+    PresetSource
+        ``source``.
+    """
+    SOURCES.append(source)
+    return source
+
+
+def _source_of(name: object) -> PresetSource | None:
+    return next((src for src in SOURCES if src.accepts(name)), None)
+
+
+def contributed() -> tuple[str, ...]:
+    """The preset names the registered sources ship (besides paths they accept)."""
+    return tuple(n for src in SOURCES for n in src.names())
+
+
 def is_reduced(name: str) -> bool:
-    """True for a preset computed from a 6-DOF model at a linearisation speed (e.g. ``remus100``)."""
-    return name in available() and "reduction_of" in _parsed(name)
+    """True for a preset computed from a 6-DOF model at a linearisation speed (e.g. ``remus100``, a vehicle file)."""
+    return _source_of(name) is not None or (name in available() and "reduction_of" in _parsed(name))
 
 
 def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
@@ -90,7 +145,8 @@ def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
     Parameters
     ----------
     name : str
-        Preset name, e.g. ``"paper"``.
+        Preset name, e.g. ``"paper"``, or a name or path a registered source accepts (a shipped
+        Fossen-type torpedo, a vehicle file ``.toml``).
     u0 : float, optional
         Linearisation speed (m/s) of a reduced preset (default: the file's ``u0``); refused for
         a preset stored as numbers.
@@ -105,10 +161,15 @@ def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
     KeyError
         If there is no such preset (the message names the available ones).
     ValueError
-        ``u0`` given for a preset that is not reduced, or out of range.
+        ``u0`` given for a preset that is not reduced, or out of range; a vehicle file that
+        breaks its rules (the message names the file and the field).
     """
+    source = _source_of(name)
+    if source is not None:
+        return source.get(name, u0)
     if name not in available():
-        raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available()}")
+        raise KeyError(f"unknown vehicle preset {name!r}; choose one of {available() + list(contributed())} "
+                       f"or a vehicle file (.toml)")
     raw = copy.deepcopy(_parsed(name))  # callers own what they get
     if "reduction_of" in raw:
         from .reduction import reduce_prestero  # a reduced preset: numbers from its 6-DOF data

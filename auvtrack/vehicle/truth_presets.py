@@ -7,6 +7,9 @@ goes into ``run.json`` so every number of a run can be traced to its source.  Sh
 
 * ``remus100_prestero`` -- Prestero (2001), :mod:`auvtrack.plant.sixdof.prestero`;
 * ``remus100_fossen`` -- Fossen (2021) / PVS ``remus100.py``, :mod:`auvtrack.plant.sixdof.fossen`.
+
+The same folder holds Fossen-type *vehicle files* (:data:`SHIPPED_FILES6`, checked by
+:mod:`auvtrack.plant.sixdof.vehicle_file`), which run on the Fossen model.
 """
 from __future__ import annotations
 
@@ -18,6 +21,7 @@ from dataclasses import dataclass
 from importlib import resources
 
 SHIPPED6: tuple[str, ...] = ("remus100_prestero", "remus100_fossen")
+SHIPPED_FILES6: tuple[str, ...] = ("remus600",)  # Fossen-type vehicle files of other vehicles
 
 
 @dataclass(frozen=True)

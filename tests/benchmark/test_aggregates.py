@@ -461,5 +461,5 @@ def _documented():
 def test_public_functions_are_fully_documented(path):
     from numpydoc.validate import validate
 
-    rules = {"GL08", "SS01", "SS03", "SS06", "PR01", "PR02", "PR03", "RT01", "RT03"}   # tests/test_docstrings.py
+    rules = {"GL08", "SS01", "SS03", "SS06", "PR01", "PR02", "PR03", "RT01", "RT03"}   # tests/docs/test_docstrings.py
     assert [f"{c}: {m}" for c, m in validate(path)["errors"] if c in rules] == []

@@ -129,7 +129,7 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
 
 
 def test_subcommand_help_lists_the_exit_codes(capsys):
-    """The top-level --help has its own table (tests/test_cli_help.py); run, check and sweep repeat it."""
+    """The top-level --help has its own table (tests/cli/test_cli_help.py); run, check and sweep repeat it."""
     from auvtrack.cli import EXIT_CODES
 
     for args in (["run", "--help"], ["check", "--help"], ["sweep", "--help"]):

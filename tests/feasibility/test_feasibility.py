@@ -411,7 +411,7 @@ def test_check_prints_the_assessment_and_run_warns_in_one_line(tmp_path):
 def test_the_numbers_in_the_docs_are_the_codes():
     from tools import feasibility_doc as doc
     text = doc.DOC.read_text()
-    assert doc.render_text(text) == text, "python tools/feasibility_doc.py render"
+    assert doc.render_text(text) == text, "python -m tools.feasibility_doc render"
 
 
 def test_api_and_bad_input_are_one_line():

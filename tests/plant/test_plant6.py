@@ -15,7 +15,7 @@ from auvtrack.plant.sixdof.actuators import effective
 from auvtrack.vehicle.kinematics import attitude
 from auvtrack.plant.sixdof.layout import (CMD_DR, CMD_DS, CMD_N, NX6, P_B, P_DMAX, P_MA, P_MINV, P_MODEL,
                                     P_MRB, P_NMAX, P_W, PP6_SIZE)
-from auvtrack.vehicle.truth_presets import SHIPPED6, available6, load_preset6
+from auvtrack.vehicle.truth_presets import SHIPPED6, SHIPPED_FILES6, available6, load_preset6
 from auvtrack.plant.sixdof.rigid import (euler_rates, kirchhoff, ned_velocity, body_from_ned6, rotation,
                                    skew, trig6)
 from auvtrack.plant.sixdof.truth import MODELS, initial_state, integrate_open_loop, pack_truth
@@ -252,7 +252,7 @@ def test_open_loop_stability_at_cruise():
 
 
 def test_shipped_presets_have_sources():
-    assert set(SHIPPED6) == set(available6())
+    assert set(SHIPPED6) | set(SHIPPED_FILES6) == set(available6())
     for name in SHIPPED6:
         pr = load_preset6(name)
         for sec in pr.record.values():

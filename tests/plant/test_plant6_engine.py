@@ -101,12 +101,16 @@ def test_current_acts_through_relative_velocity():
 
 
 def test_open_loop_actuator_bad_input():
+    """Commands beyond the plant's actuators are refused at set-up (check and run alike), a plant
+    that takes no actuator commands when the scenario is loaded."""
     from auvtrack.scenario import ScenarioError
-    with pytest.raises(ScenarioError, match=r"controller.delta_r: beyond the actuator limit plant.delta_max = 0.261799"):
-        load_scenario(REMUS, ["plant.model=6dof", "controller.kind=open_loop_actuators", "controller.delta_r=0.5"])
-    with pytest.raises(ScenarioError, match=r"controller.rpm: beyond the actuator limit plant.n_max = 1525"):
-        load_scenario(REMUS, ["plant.model=6dof", "controller.kind=open_loop_actuators", "controller.rpm=2000"])
-    with pytest.raises(ScenarioError, match=r"controller.kind: open_loop_actuators commands fins and propeller"):
+    from auvtrack.simulation.pipeline import prepare
+    with pytest.raises(ValueError, match=r"controller.delta_r: beyond the actuator limit plant.delta_max = 0.237365"):
+        prepare(load_scenario(REMUS, ["plant.model=6dof", "controller.kind=open_loop_actuators", "controller.delta_r=0.5"]))
+    with pytest.raises(ValueError, match=r"controller.rpm: beyond the actuator limit plant.n_max = 1525"):
+        prepare(load_scenario(REMUS, ["plant.model=6dof", "controller.kind=open_loop_actuators", "controller.rpm=2000"]))
+    with pytest.raises(ScenarioError, match=r"controller.kind: open_loop_actuators commands the actuators; plant.model "
+                                            r"'5dof' accepts tau"):
         load_scenario(REMUS, ["controller.kind=open_loop_actuators"])
 
 

@@ -32,8 +32,8 @@ def test_plant_model_6dof_as_typed_defaults_to_prestero():
 
 
 @pytest.mark.parametrize("sets, message", [
-    (["plant.model=7dof"], r"plant.model: must be one of '5dof' or '6dof' \(got '7dof'\)"),
-    (["plant.model=6dof", "plant.preset=remus200"], r"plant.preset: unknown 6-DOF preset \(allowed: remus100_fossen, remus100_prestero\)"),
+    (["plant.model=7dof"], r"plant.model: unknown model \(allowed: '5dof', '6dof', 'plugin'\) \(got '7dof'\)"),
+    (["plant.model=6dof", "plant.preset=remus200"], r"plant.preset: unknown 6-DOF preset \(allowed: remus100_fossen, remus100_prestero, remus600 or a vehicle file .toml\)"),
     (["plant.preset=remus100_fossen"], r"plant.preset: only for plant.model = \"6dof\""),
     (["plant.n_max=1000"], r"plant.n_max: only for plant.model = \"6dof\""),
     (["plant.model=6dof", "plant.n_max=-5"], r"plant.n_max: must be > 0 \(got -5\)"),

@@ -82,7 +82,7 @@ def estimate_and_adapt3(X, off, m, psi, S, gain, dX):
     """:func:`estimate_and_adapt` (eq. 33-34) of the three axes in one pass over the neurons.
 
     The law's form; the same operations in the same order per axis, so bit-identical to three
-    :func:`estimate_and_adapt` calls (``tests/test_vecmath.py``).  Axis i's weights are
+    :func:`estimate_and_adapt` calls (``tests/engine/test_vecmath.py``).  Axis i's weights are
     X[off + i m : off + (i + 1) m]; S (m/s) and gain are 3-tuples; returns chi_hat (m/s^2).
     """
     c0 = c1 = c2 = 0.0

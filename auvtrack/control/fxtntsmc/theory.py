@@ -21,7 +21,7 @@ Corrections to the proof applied here (each derived in ``docs/theory.md``):
 4. T2: z crosses the outer region (S_e > sigma, time <= T21) and *then* the inner one
    (S_e <= sigma, time <= T22); the phases are sequential, so T2 = T21 + T22.  The printed
    T2 = max{T21, T22} is reported for comparison only: it is exceeded on the sliding manifold
-   S = 0 for admissible gains (``tests/test_theory.py``).
+   S = 0 for admissible gains (``tests/control/test_theory.py``).
 
 The lam1, lam2 of (39)-(42) are free Young-inequality constants of the proof, NOT the envelope
 gains lambda1, lambda2 of eq. (25) that share the name; here they are ``lam1``, ``lam2``.
@@ -333,7 +333,7 @@ def _se(z: float, a1: float, a2: float, a3: float, a4: float) -> float:
     """S_e(z) of eq. (28) as printed, for z >= 0 (z dimensionless), for root finding.
 
     Scalar Python form of :func:`auvtrack.control.fxtntsmc.surface` with ``printed`` (pinned to
-    it in ``tests/test_theory.py``), which is NaN at z = 0 (it forms z^(a2-1)); this one is 0 there.
+    it in ``tests/control/test_theory.py``), which is NaN at z = 0 (it forms z^(a2-1)); this one is 0 there.
     """
     return a1 * z**a2 + a3 * z**a4
 

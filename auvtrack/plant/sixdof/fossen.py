@@ -6,10 +6,11 @@ and every source are in ``auvtrack/data/vehicles/6dof/remus100_fossen.toml``.  M
     nu_dot = nu_c_dot + M^-1 ( tau_act + tau_ld(nu_r) + tau_cf(nu_r) - C(nu_r) nu_r - D(nu_r) nu_r
                                - g(eta) + tau_d )
 
-* rigid body of a prolate spheroid (a = L/2, b = diam/2) of mass m = 4/3 pi rho a b^2 with its
-  CG r_g below the CO: ``M_RB = H(r_g)^T diag(m, m, m, Ix, Iy, Iz) H(r_g)`` (F21 eq. 3.42);
-* added mass from Lamb's k-factors (F21 eq. 8.x): ``M_A = diag(m k1, m k2, m k2, r44 Ix, k' Iy,
-  k' Iy)``; ``M = M_RB + M_A``;
+* rigid body of a prolate spheroid (a = L/2, b = diam/2) of mass m = 4/3 pi rho a b^2 (or the
+  file's ``hull.mass``) with its CG r_g below the CO: ``M_RB = H(r_g)^T diag(m, m, m, Ix, Iy, Iz)
+  H(r_g)`` (F21 eq. 3.42);
+* added mass from Lamb's k-factors (F21 eq. 8.x) of the displaced water m_f = 4/3 pi rho a b^2:
+  ``M_A = diag(m_f k1, m_f k2, m_f k2, r44 Ix, k' Iy_f, k' Iy_f)``; ``M = M_RB + M_A``;
 * ``C = C_RB(nu_r) + C_A(nu_r)`` in Kirchhoff form, **with the model's simplification** that the
   added-mass terms C_A[4,0], C_A[0,4], C_A[4,2], C_A[2,4], C_A[5,0], C_A[0,5], C_A[5,1], C_A[1,5]
   (surge-pitch/heave-pitch quadratic terms and the Munk moments in pitch and yaw) are zero;
@@ -24,7 +25,8 @@ and every source are in ``auvtrack/data/vehicles/6dof/remus100_fossen.toml``.  M
   Wageningen KT, KQ in the advance number J = 0.944 U / (n D), U the speed over ground), and
   rudder / stern-plane lift and drag ``-1/2 rho U_rh^2 A_r CL_r delta_r`` (sway) etc. acting at
   x_r = x_s = -L/2;
-* ``g``: restoring forces of W = B at r_g, r_b (F21 eq. 4.6);
+* ``g``: restoring forces of W at r_g and B at r_b (F21 eq. 4.6); W = B unless the file gives
+  ``hull.mass`` and ``hull.buoyancy``;
 * currents (the model's simplification): the horizontal NED current (Vx, Vy) is rotated by the
   heading only, ``nu_c = (Vx cos psi + Vy sin psi, -Vx sin psi + Vy cos psi, 0, 0, 0, 0)``, with
   ``nu_c_dot = (r v_c, -r u_c, 0, 0, 0, 0)``; a vertical current is ignored.
@@ -77,27 +79,38 @@ def lamb_k_factors(a: float, b: float) -> tuple[float, float, float]:
 
 
 def derived(pr: Preset6) -> dict:
-    """Every derived number of the model (mass, inertia, M_RB, M_A, damping, ...), SI units."""
+    """Every derived number of the model (mass, inertia, M_RB, M_A, damping, ...), SI units.
+
+    The displaced water is the spheroid's, m_f = 4/3 pi rho a b^2; the vehicle's mass is
+    ``hull.mass`` if given, else m_f (neutral, as PVS), its buoyancy ``hull.buoyancy`` if given,
+    else B = W (trimmed neutral).  Rigid-body inertia of a uniform spheroid of the vehicle's mass
+    (Ix = 2/5 m b^2, Iy = Iz = 1/5 m (a^2 + b^2)); added mass from Lamb's k-factors times the
+    displaced water (roll: r44 Ix).  Righting coefficient W z_g - B z_b (N m; Prestero 2001
+    eq. 9.7) sets the roll and pitch natural frequencies of the damping.
+    """
     v = pr.values
     rho, L, d = v["hull.rho"], v["hull.L"], v["hull.diam"]
     a, b = L / 2.0, d / 2.0
     S = v["hull.S_ratio"] * L * d
-    m = 4.0 / 3.0 * math.pi * rho * a * b * b
+    m_f = 4.0 / 3.0 * math.pi * rho * a * b * b
+    m = v.get("hull.mass", m_f)
     Ix, Iy = 0.4 * m * b * b, 0.2 * m * (a * a + b * b)
+    Iy_f = 0.2 * m_f * (a * a + b * b)
     r_g = np.asarray(v["hull.r_g"])
     M_rb = rigid_body_mass(m, inertia_about_origin(m, np.diag([Ix, Iy, Iy]), r_g), r_g)
     k1, k2, kp = lamb_k_factors(a, b)
-    M_a = np.diag([m * k1, m * k2, m * k2, v["hull.r44"] * Ix, kp * Iy, kp * Iy])
+    M_a = np.diag([m_f * k1, m_f * k2, m_f * k2, v["hull.r44"] * Ix, kp * Iy_f, kp * Iy_f])
     M = M_rb + M_a
     W = m * v["hull.g"]
-    dz = r_g[2] - v["hull.r_b"][2]
-    w_roll, w_pitch = math.sqrt(W * dz / M[3, 3]), math.sqrt(W * dz / M[4, 4])
+    B = v.get("hull.buoyancy", W)
+    gm = W * r_g[2] - B * v["hull.r_b"][2]
+    w_roll, w_pitch = math.sqrt(gm / M[3, 3]), math.sqrt(gm / M[4, 4])
     dmp = v
     D = (M[0, 0] / dmp["damping.T_surge"], M[1, 1] / dmp["damping.T_sway"],
          M[2, 2] / dmp["damping.T_heave"], 2.0 * dmp["damping.zeta_roll"] * w_roll * M[3, 3],
          2.0 * dmp["damping.zeta_pitch"] * w_pitch * M[4, 4], M[5, 5] / dmp["damping.T_yaw"])
     AR = d * d / S
-    return dict(m=m, Ix=Ix, Iy=Iy, W=W, B=W, S=S, M_rb=M_rb, M_a=M_a, M=M, k=(k1, k2, kp),
+    return dict(m=m, m_f=m_f, Ix=Ix, Iy=Iy, W=W, B=B, gm=gm, S=S, M_rb=M_rb, M_a=M_a, M=M, k=(k1, k2, kp),
                 w_roll=w_roll, w_pitch=w_pitch, D=D, AR=AR,
                 CD_0=v["hull.Cd"] * math.pi * b * b / S,
                 CL_alpha=math.pi * AR / (1.0 + math.sqrt(1.0 + (AR / 2.0) ** 2)),
@@ -110,7 +123,8 @@ def pack(pr: Preset6, common: np.ndarray) -> np.ndarray:
     Parameters
     ----------
     pr : Preset6
-        ``remus100_fossen``.
+        ``remus100_fossen`` or a vehicle file of the same form
+        (:mod:`auvtrack.plant.sixdof.vehicle_file`).
     common : numpy.ndarray
         Length :data:`PP6_SIZE` with the common actuator fields already set.
 
@@ -123,8 +137,8 @@ def pack(pr: Preset6, common: np.ndarray) -> np.ndarray:
     dd = derived(pr)
     pp = np.array(common, dtype=np.float64, copy=True)
     assert pp.size == PP6_SIZE
-    check_spd(dd["M_rb"], "remus100_fossen M_RB")
-    check_spd(dd["M"], "remus100_fossen M_RB + M_A")
+    check_spd(dd["M_rb"], f"{pr.name} M_RB")
+    check_spd(dd["M"], f"{pr.name} M_RB + M_A")
     pp[P_MINV:P_MINV + 36] = np.linalg.inv(dd["M"]).ravel()
     pp[P_MRB:P_MRB + 36] = dd["M_rb"].ravel()
     pp[P_MA:P_MA + 36] = dd["M_a"].ravel()

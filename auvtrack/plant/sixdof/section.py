@@ -7,9 +7,10 @@ from typing import Annotated, Any, Literal, Mapping
 from pydantic import Field, field_validator, model_validator
 
 from ...fields import Num, Pos, PosOrInf, Str, format_value, inf_words
-from ...vehicle.truth_presets import available6, load_preset6
+from ...vehicle.truth_presets import available6
+from ...vehicle.vehicle_file import is_vehicle_ref, resolve_path
 from ..registry import PlantSection
-from .truth import ACTUATOR_KEYS, actuator_values
+from .truth import ACTUATOR_KEYS, actuator_values, truth_preset
 
 DEFAULT_PRESET = "remus100_prestero"
 
@@ -22,7 +23,8 @@ class Section(PlantSection):
     """
 
     model: Literal["6dof"] = "6dof"
-    preset: Str = Field(DEFAULT_PRESET, description="6-DOF preset: remus100_prestero (default) or remus100_fossen")
+    preset: Str = Field(DEFAULT_PRESET, description="6-DOF preset: remus100_prestero (default), remus100_fossen, "
+                                                     "remus600, or a Fossen-type vehicle file (.toml)")
     delta_max: Annotated[Num, Field(gt=0, le=math.pi / 2)] | None = Field(None, description="fin angle limit, rad")
     n_max: Pos | None = Field(None, description="propeller speed limit, rpm")
     T_delta: Pos | None = Field(None, description="fin time constant, s")
@@ -40,15 +42,22 @@ class Section(PlantSection):
     def _default_preset(cls, data: Any) -> Any:
         if isinstance(data, Mapping) and data.get("preset") is None:
             return {**data, "preset": DEFAULT_PRESET}
+        if isinstance(data, Mapping) and is_vehicle_ref(data.get("preset")):  # relative to the working directory
+            return {**data, "preset": resolve_path(data["preset"])}
         return data
 
     @model_validator(mode="after")
     def _preset(self) -> "Section":
         names = available6()
-        if self.preset not in names:
-            raise ValueError(f"preset: unknown 6-DOF preset (allowed: {', '.join(names)}) (got {self.preset!r})")
+        if self.preset not in names and not is_vehicle_ref(self.preset):
+            raise ValueError(f"preset: unknown 6-DOF preset (allowed: {', '.join(names)} or a vehicle file .toml) "
+                             f"(got {self.preset!r})")
         try:
-            actuator_values(load_preset6(self.preset), self.actuator_overrides())
+            pr = truth_preset(self.preset)[0]
+        except ValueError as exc:  # a vehicle file: "<file>: <section.key>: ..."
+            raise ValueError(f"preset: {exc}") from None
+        try:
+            actuator_values(pr, self.actuator_overrides())
         except ValueError as exc:  # "plant.<key>: ..." -> "<key>: ..."
             raise ValueError(str(exc).removeprefix("plant.")) from None
         return self
@@ -59,7 +68,7 @@ class Section(PlantSection):
 
     def actuator_limits(self) -> dict[str, float]:
         """Effective actuator numbers (the preset's with the overrides)."""
-        return actuator_values(load_preset6(self.preset), self.actuator_overrides())
+        return actuator_values(truth_preset(self.preset)[0], self.actuator_overrides())
 
 
 def check_scenario(scenario) -> None:

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .layout import LOG_NAMES6
-from ...vehicle.truth_presets import load_preset6
-from .truth import MODELS, initial_state, pack_truth, trim_rpm
+from .truth import initial_state, pack_truth, trim_rpm, truth_preset
+from ...vehicle.vehicle_file import file_digest, is_vehicle_ref
 
 
 @dataclass(frozen=True)
@@ -68,11 +68,13 @@ def prepare_truth(section, ctx) -> Truth6:
     rpm0 = trim_rpm(name, pp, n[0])
     x0 = initial_state((e[0], e[1], e[2], ctx.phi0, e[3], e[4]), (n[0], n[1], n[2], ctx.p0, n[3], n[4]),
                        (0.0, 0.0, rpm0))
-    pr = load_preset6(name)
+    pr, model = truth_preset(name)
     notes = (f"6-DOF truth {name}: the controller's design model is the 5-DOF vehicle "
              f"{ctx.design_preset!r}; it measures the 5-DOF projection (no roll)",
              f"initial propeller speed {rpm0:.6g} rpm: surge balance at u = {n[0]:g} m/s",)
     resolved = {"model": "6dof", "preset": name, "description": pr.description,
-                "equations": MODELS[name].__name__, "actuators": limits, "initial_rpm": rpm0,
+                "equations": model.__name__, "actuators": limits, "initial_rpm": rpm0,
                 "coefficients": pr.record}
+    if is_vehicle_ref(name):
+        resolved["file"] = {"path": name, "sha256": file_digest(name)}
     return Truth6(pp=pp, x0=x0, log_names=LOG_NAMES6, notes=notes, resolved=resolved)

@@ -17,11 +17,49 @@ from . import fossen, prestero
 from ...vehicle.kinematics import attitude
 from .layout import (EQUATIONS_FOSSEN, EQUATIONS_PRESTERO, IX_DR, IX_DS, IX_N, NX6, P_DIRECT, P_EQUATIONS, P_DMAX, P_DRATE, P_MINV, P_NMAX, P_NRATE,
                       P_TDELTA, P_TN, PP6_SIZE)
-from ...vehicle.truth_presets import Preset6, load_preset6
+from ...vehicle.truth_presets import Preset6, available6, load_preset6
+from ...vehicle.vehicle_file import is_vehicle_ref, load_vehicle_file, shipped_dir
 
 MODELS: dict[str, ModuleType] = {"remus100_prestero": prestero, "remus100_fossen": fossen}
 EQUATIONS = {prestero: EQUATIONS_PRESTERO, fossen: EQUATIONS_FOSSEN}
 """The code of each model's equations of motion in ``pp[P_EQUATIONS]``."""
+
+
+def truth_preset(name: str) -> tuple[Preset6, ModuleType]:
+    """The numbers and the model module of a 6-DOF truth.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`MODELS`, the name of another shipped 6-DOF file (a Fossen-type vehicle
+        file, e.g. ``remus600``) or the path of a vehicle file (``.toml``, relative to the
+        working directory).
+
+    Returns
+    -------
+    (Preset6, module)
+        The checked numbers, and :mod:`~auvtrack.plant.sixdof.prestero` or
+        :mod:`~auvtrack.plant.sixdof.fossen` (every vehicle file is a Fossen-type torpedo).
+
+    Raises
+    ------
+    KeyError
+        An unknown name.
+    ValueError
+        A vehicle file that breaks its rules (:mod:`auvtrack.plant.sixdof.vehicle_file`).
+    """
+    if name in MODELS:
+        return load_preset6(name), MODELS[name]
+    if is_vehicle_ref(name):
+        return load_vehicle_file(name), fossen
+    if name in available6():
+        return load_vehicle_file(shipped_dir() / f"{name}.toml"), fossen
+    raise KeyError(f"unknown 6-DOF preset {name!r}; choose one of {available6()} or a vehicle file (.toml)")
+
+
+def model_of(name: str) -> ModuleType:
+    """The model module (:mod:`~auvtrack.plant.sixdof.prestero` or :mod:`~auvtrack.plant.sixdof.fossen`) of a truth ``name``."""
+    return MODELS.get(name) or truth_preset(name)[1]
 
 ACTUATOR_KEYS = ("delta_max", "n_max", "T_delta", "T_n", "delta_rate_max", "n_rate_max")
 _SLOTS = dict(zip(ACTUATOR_KEYS, (P_DMAX, P_NMAX, P_TDELTA, P_TN, P_DRATE, P_NRATE)))
@@ -57,7 +95,7 @@ def pack_truth(name: str, overrides: dict | None = None, direct: bool = False) -
     Parameters
     ----------
     name : str
-        A key of :data:`MODELS`.
+        A truth (:func:`truth_preset`).
     overrides : dict, optional
         Actuator settings replacing the preset's (keys :data:`ACTUATOR_KEYS`).
     direct : bool
@@ -68,13 +106,13 @@ def pack_truth(name: str, overrides: dict | None = None, direct: bool = False) -
     numpy.ndarray
         Length :data:`auvtrack.plant.sixdof.layout.PP6_SIZE`.
     """
-    pr = load_preset6(name)
+    pr, model = truth_preset(name)
     common = np.zeros(PP6_SIZE)
     for k, x in actuator_values(pr, overrides).items():
         common[_SLOTS[k]] = x
     common[P_DIRECT] = 1.0 if direct else 0.0
-    common[P_EQUATIONS] = EQUATIONS[MODELS[name]]
-    return MODELS[name].pack(pr, common)
+    common[P_EQUATIONS] = EQUATIONS[model]
+    return model.pack(pr, common)
 
 
 def trim_rpm(name: str, pp: np.ndarray, u: float) -> float:
@@ -91,7 +129,7 @@ def trim_rpm(name: str, pp: np.ndarray, u: float) -> float:
     """
     if u <= 0.0:
         return 0.0
-    model = MODELS[name]
+    model = model_of(name)
     dx = np.zeros(NX6)
     cmd = np.zeros(6)
     att = attitude(0.0, 0.0)
@@ -149,7 +187,7 @@ def integrate_open_loop(name: str, commands, t_end: float, dt: float, x0=None,
     dict
         ``{t: state}`` for each requested time, and ``"final"``.
     """
-    model = MODELS[name]
+    model = model_of(name)
     pp = pack_truth(name) if pp is None else pp
     x = initial_state() if x0 is None else np.array(x0, dtype=np.float64)
     cmd = np.zeros(6)
