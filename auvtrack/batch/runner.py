@@ -13,8 +13,8 @@ Two parallel back ends (measured in ``benchmarks/results.md``):
 * ``"threads"`` (default): a thread pool over the ``nogil`` kernel; the arrays of each run are
   passed as they are, so scenarios of any shape can be mixed.
 * ``"prange"``: one compiled ``numba.prange`` loop over runs of identical array shapes
-  (the kernel's ``run_many``), grouped automatically.  About 1.4-1.8x serial on 2 cores, like the threads
-  (``benchmarks/results.md``), but never call it from several Python threads at once:
+  (the kernel's ``run_many``), grouped automatically (its speed: ``benchmarks/results.md``); never
+  call it from several Python threads at once:
   Numba's default ``workqueue`` threading layer is not re-entrant and aborts the process.
 """
 from __future__ import annotations

@@ -46,7 +46,7 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
     from ..perf.bench import bench_plant, bench_singles
     from ..simulation.compiling import builtin_controllers
 
-    if plant != "5dof":  # issue 11: the 6-DOF truths, one line per (controller, preset)
+    if plant != "5dof":  # the 6-DOF truths, one line per (controller, preset)
         for row in bench_plant(controllers or ("ftsmc", "fxtntsmc"), plant, repeat=repeat, duration=duration):
             click.echo(json.dumps(row))
         return

@@ -131,8 +131,8 @@ def njit_noalloc(*args, **kwargs):
 
     Numba increments and decrements the reference count of every array argument on entry and
     exit of a compiled function (an atomic operation each); for the small functions called at
-    every RK4 stage this cost more than their arithmetic (FXTNTSMC 2.9 -> 2.0 us per step, FTSMC
-    2.3 -> 1.1, results bit-identical).  ``_nrt=False`` (a private Numba option) compiles the
+    every RK4 stage this costs more than their arithmetic (the measurement: ``benchmarks/profile.md``;
+    results bit-identical).  ``_nrt=False`` (a private Numba option) compiles the
     function without the runtime: an allocation added to it fails to compile instead of leaking.
     Remove the option here to revert every such function at once.
     """

@@ -8,7 +8,7 @@ calls, so these functions call it directly:
 
 * ``_ZGVdN4vv_pow`` (AVX2, 4 lanes) for :func:`pow4`;
 * two ``_ZGVdN4v_exp`` (AVX2, 4 lanes) for :func:`exp8` (libmvec's 8-lane AVX-512 exp gives the same
-  numbers but made the FXTNTSMC 5 % slower here, ``benchmarks/profile.md``);
+  numbers but was slower here, ``benchmarks/profile.md``);
 * ``_ZGVdN4v_sin`` and ``_ZGVdN4v_cos`` (AVX2, 4 lanes) for :func:`sincos4`: the attitude
   (theta, psi) of every stage and the two arguments of the paper's disturbance;
 * ``_ZGVdN4v_atanh`` (AVX2, 4 lanes, glibc >= 2.35) for :func:`atanh4`: z of eq. (17), three axes.

@@ -77,7 +77,7 @@ def _overrides(kind: str) -> list[str]:
     return [f"controller.kind={kind}"]
 
 
-# issue 11: the 6-DOF benchmark runs a straight line at 1 m/s from on track (remus100 design model),
+# the 6-DOF benchmark runs a straight line at 1 m/s from on track (remus100 design model),
 # envelope off: a closed loop every controller completes on both truths (the Section 4 start from
 # rest leaves the fins without authority and several controllers stop early; the model-gap study
 # reports that).  Each preset is timed as its own row.

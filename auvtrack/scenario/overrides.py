@@ -25,7 +25,7 @@ __all__ = ["Override", "parse_overrides", "apply_overrides", "KIND_DEFAULTS"]
 
 Segment = str | int
 _SEGMENT = re.compile(r"^(?:[A-Za-z_][A-Za-z0-9_\-]*|\d+)$")
-# issue 11: a bare word may start with a digit when it has a letter (``plant.model=6dof``)
+# a bare word may start with a digit when it has a letter (``plant.model=6dof``)
 _BARE_WORD = re.compile(r"^(?=.*[A-Za-z_])[A-Za-z0-9_][A-Za-z0-9_.\-+]*$")
 # a bare file path (a vehicle file, a plug-in): plant.preset=../auvs/my_auv.toml
 _BARE_PATH = re.compile(r"^[A-Za-z0-9_.~/\-+]+\.(?:toml|py)$")
