@@ -42,7 +42,7 @@ from numba import prange
 from ..control.contract import WORK_SIZE, LawArgs, LawOutputs, Measured
 from ..control.contract import control as law
 from ..control.tracking import lumped_disturbance
-from ..environment.layout import KIND_PAPER, KIND_PULSE
+from ..environment.dispatch import time_only
 from ..environment.sensors import measure
 from ..packing import packed_layout
 from ..plant import contract as plant
@@ -221,7 +221,7 @@ def run__lanes(pb, cb, env, ref_p, settings, out, mask):
 def state_free_disturbance(d_rows):
     """True when omega depends on time only (paper and pulse components), not on the state."""
     for k in range(d_rows.shape[0]):
-        if d_rows[k, 0] != KIND_PAPER and d_rows[k, 0] != KIND_PULSE:
+        if not time_only(d_rows[k, 0]):
             return False
     return True
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -61,6 +62,12 @@ class GaussMarkovCurrent:
     sample_dt : float
         Grid step of the generated samples, s, > 0.
     """
+
+    KIND: ClassVar[str] = "current"
+    CODE: ClassVar[float] = KIND_CURRENT
+    EFFECT: ClassVar[str] = "current"
+    TIME_ONLY: ClassVar[bool] = False
+    TERM: ClassVar[str] = "current_velocity"
 
     mean: tuple[float, ...] = (0.0, 0.0, 0.0)
     sigma: tuple[float, ...] = (0.05, 0.05, 0.0)

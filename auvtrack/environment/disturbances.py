@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -40,6 +41,12 @@ class PaperDisturbance:
     phase : float
         Phase offset added to every sine/cosine argument, rad (0 reproduces the paper).
     """
+
+    KIND: ClassVar[str] = "paper"
+    CODE: ClassVar[float] = KIND_PAPER
+    EFFECT: ClassVar[str] = "force"
+    TIME_ONLY: ClassVar[bool] = True
+    TERM: ClassVar[str] = "add_paper"
 
     amplitude: float = 1.0
     phase: float = 0.0
@@ -73,6 +80,12 @@ class Pulse:
     force : sequence of 5 float
         [F_u, F_v, F_w] in N and [M_q, M_r] in N m, body frame.
     """
+
+    KIND: ClassVar[str] = "pulse"
+    CODE: ClassVar[float] = KIND_PULSE
+    EFFECT: ClassVar[str] = "force"
+    TIME_ONLY: ClassVar[bool] = True
+    TERM: ClassVar[str] = "add_pulse"
 
     start: float
     duration: float

@@ -20,11 +20,10 @@ import numpy as np
 from ..jit import njit, njit_noalloc
 from .._seeding import rng
 from ..vehicle.params import VP
-from .current import GaussMarkovCurrent, add_current_force, current_velocity
-from .disturbances import PaperDisturbance, Pulse, add_paper, add_pulse
-from .layout import C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, KIND_PAPER, KIND_PULSE, ROW_SIZE
-
-COMPONENT_TYPES = (PaperDisturbance, Pulse, GaussMarkovCurrent)
+from .current import add_current_force
+from .dispatch import add_forces, current_of
+from .layout import C_N, C_OFFSET, CUR_COLS, KIND_CURRENT, ROW_SIZE
+from .registry import COMPONENTS
 
 
 @njit_noalloc(inline="always")
@@ -52,16 +51,13 @@ def eval_disturbance(rows, current, t, eta, nu, vp, out):
     vx = vy = vz = 0.0
     have_current = bad = False
     for k in range(rows.shape[0]):
-        code = rows[k, 0]
-        if code == KIND_PAPER:
-            add_paper(rows, k, t, out)
-        elif code == KIND_PULSE:
-            add_pulse(rows, k, t, out)
-        elif code == KIND_CURRENT:
-            cx, cy, cz = current_velocity(rows, k, current, t)
-            vx += cx
-            vy += cy
-            vz += cz
+        if add_forces(rows, k, t, out):
+            continue
+        hit, v = current_of(rows, k, current, t)
+        if hit:
+            vx += v[0]
+            vy += v[1]
+            vz += v[2]
             have_current = True
         else:
             bad = True
@@ -77,11 +73,11 @@ def eval_current_velocity(rows, current, t, out):
     """Write the summed current velocity V_c(t) (3,), m/s NED, of all current rows into ``out``."""
     out[0] = out[1] = out[2] = 0.0
     for k in range(rows.shape[0]):
-        if rows[k, 0] == KIND_CURRENT:
-            cx, cy, cz = current_velocity(rows, k, current, t)
-            out[0] += cx
-            out[1] += cy
-            out[2] += cz
+        hit, v = current_of(rows, k, current, t)
+        if hit:
+            out[0] += v[0]
+            out[1] += v[1]
+            out[2] += v[2]
 
 
 @njit
@@ -122,7 +118,7 @@ class DisturbanceTables:
     @property
     def has_current(self) -> bool:
         """Whether any component is a current (the evaluator then needs ``vp``)."""
-        return any(isinstance(c, GaussMarkovCurrent) for c in self.components)
+        return any(c.EFFECT == "current" for c in self.components)
 
     def evaluate(self, t, eta=None, nu=None, vp=None) -> np.ndarray:
         """Evaluate omega with the compiled evaluator (for tests and plots).
@@ -176,7 +172,7 @@ class DisturbanceTables:
         comps, i = [], 0
         for c in self.components:
             d = c.describe()
-            if isinstance(c, GaussMarkovCurrent):
+            if c.EFFECT == "current":
                 d = {**d, "stream": f"current/{i}"}
                 i += 1
             comps.append(d)
@@ -206,10 +202,10 @@ def pack_disturbances(components: list, duration: float, seed: int) -> Disturban
         raise ValueError(f"duration must be a finite real number >= 0 (s), got {duration!r}")
     rows, tables, offset, i_cur = [], [], 0, 0
     for c in components:
-        if not isinstance(c, COMPONENT_TYPES):
+        if not isinstance(c, COMPONENTS):
             raise ValueError(f"disturbance component must be one of "
-                             f"{[t.__name__ for t in COMPONENT_TYPES]}, got {type(c).__name__}")
-        if isinstance(c, GaussMarkovCurrent):
+                             f"{[t.__name__ for t in COMPONENTS]}, got {type(c).__name__}")
+        if c.EFFECT == "current":
             samples = c.sample(float(duration), rng(seed, f"current/{i_cur}"))
             rows.append(c.pack_row(offset, samples.shape[0]))
             tables.append(samples)

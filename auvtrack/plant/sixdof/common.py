@@ -11,9 +11,7 @@ from __future__ import annotations
 import math
 
 from ...jit import njit_noalloc
-from ...environment.current import current_velocity
-from ...environment.disturbances import add_paper, add_pulse
-from ...environment.layout import KIND_CURRENT, KIND_PAPER, KIND_PULSE
+from ...environment.dispatch import add_forces, current_of
 from .actuators import effective
 from ..contract import CAUSE_PITCH, CAUSE_ROLL, SF
 from .layout import CMD_DR, CMD_DS, CMD_N, CMD_TAU, P_DIRECT, P_DMAX, P_NMAX
@@ -54,16 +52,13 @@ def environment(rows, current, t, scr, fresh):
         for i in range(8):
             scr[i] = 0.0
         for k in range(rows.shape[0]):
-            code = rows[k, 0]
-            if code == KIND_PAPER:
-                add_paper(rows, k, t, scr)
-            elif code == KIND_PULSE:
-                add_pulse(rows, k, t, scr)
-            elif code == KIND_CURRENT:
-                cx, cy, cz = current_velocity(rows, k, current, t)
-                scr[SCR_VC] += cx
-                scr[SCR_VC + 1] += cy
-                scr[SCR_VC + 2] += cz
+            if add_forces(rows, k, t, scr):
+                continue
+            hit, v = current_of(rows, k, current, t)
+            if hit:
+                scr[SCR_VC] += v[0]
+                scr[SCR_VC + 1] += v[1]
+                scr[SCR_VC + 2] += v[2]
             else:
                 scr[0] = math.nan
     return ((scr[0], scr[1], scr[2], 0.0, scr[3], scr[4]),
