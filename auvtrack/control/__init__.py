@@ -4,20 +4,23 @@ Registering a built-in controller is one line: its module in :data:`BUILTIN` (ch
 :mod:`auvtrack.control.contract`).  ``plugin`` is registered after them: it is the loader of
 controllers from outside the package (kind ``"plugin"``).
 """
-from . import backstepping, ftsmc, fxtntsmc, open_loop, open_loop_actuators, pid, plugin, ppc, sta
+from importlib import import_module
+
+from . import plugin
 from .registry import (CONTROLLERS, CompiledController, ControllerParams, ControllerSpec, SetupContext,
                        check_controller, get, register)
 
-BUILTIN = (
-    fxtntsmc,
-    ftsmc,
-    pid,
-    backstepping,
-    sta,
-    ppc,
-    open_loop,
-    open_loop_actuators,
-)
+BUILTIN = tuple(import_module(f"{__name__}.{name}") for name in (
+    "fxtntsmc",
+    "ftsmc",
+    "pid",
+    "backstepping",
+    "sta",
+    "ppc",
+    "open_loop",
+    "open_loop_actuators",
+))
+"""The built-in controller modules, in registry order (add one: its module name here)."""
 BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
 """Kinds of the built-in controllers (``plugin``, the loader of outside controllers, is not one)."""
 for _module in BUILTIN:

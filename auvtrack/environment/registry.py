@@ -6,16 +6,20 @@
 from __future__ import annotations
 
 from dataclasses import fields
+from importlib import import_module
 
-from .current import GaussMarkovCurrent
-from .disturbances import PaperDisturbance, Pulse
 
-COMPONENTS: tuple[type, ...] = (
-    PaperDisturbance,
-    Pulse,
-    GaussMarkovCurrent,
-)
-"""The registered components: adding one is its module plus one line here."""
+def _component(path: str) -> type:
+    module, name = path.split(":")
+    return getattr(import_module(f"{__package__}.{module}"), name)
+
+
+COMPONENTS: tuple[type, ...] = tuple(_component(path) for path in (
+    "disturbances:PaperDisturbance",
+    "disturbances:Pulse",
+    "current:GaussMarkovCurrent",
+))
+"""The registered components, ``module:Class`` (adding one: its module plus one line here)."""
 
 EFFECTS = ("force", "current")
 

@@ -4,10 +4,16 @@ Registering a plant is one line here: ``register(module)`` (checked against
 :mod:`auvtrack.plant.contract`).  ``plugin`` is registered after them: it is the loader of plants
 from outside the package (``plant.model = "plugin"``).
 """
-from . import five_dof, plugin, sixdof
+from importlib import import_module
+
+from . import plugin
 from .registry import PLANTS, CompiledPlant, PlantContext, PlantSpec, check_plant, get, register
 
-BUILTIN = (five_dof, sixdof)
+BUILTIN = tuple(import_module(f"{__name__}.{name}") for name in (
+    "five_dof",
+    "sixdof",
+))
+"""The built-in plant modules (add one: its module name here)."""
 BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
 """Models of the built-in plants (``plugin``, the loader of outside plants, is not one)."""
 for _module in BUILTIN:
