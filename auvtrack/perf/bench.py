@@ -60,10 +60,15 @@ def plugin_copy(kind: str, folder: Path) -> Path:
 
     from ..control import get
 
-    src = Path(importlib.import_module(get(kind).module).__file__).read_text()
-    src = re.sub(r"^from \.\.(\w+)", r"from auvtrack.\1", src, flags=re.M)
-    src = re.sub(r"^from \.(\w+)", r"from auvtrack.control.\1", src, flags=re.M)
-    src = re.sub(r"^from \. import", "from auvtrack.control import", src, flags=re.M)
+    module = importlib.import_module(get(kind).module)
+    package = module.__name__ if Path(module.__file__).name == "__init__.py" else module.__name__.rsplit(".", 1)[0]
+
+    def absolute(m: re.Match) -> str:  # a relative import, resolved against the module's package
+        dots, rest = m.group(1), m.group(2)
+        base = package.split(".")[: len(package.split(".")) - len(dots) + 1]
+        return "from " + ".".join(base + ([rest] if rest else [])) + " import"
+
+    src = re.sub(r"^from (\.+)([\w.]*) import", absolute, Path(module.__file__).read_text(), flags=re.M)
     path = Path(folder) / f"copy_of_{kind}.py"
     if not (path.is_file() and path.read_text() == src):  # unchanged: keep it (and its cached kernel)
         path.write_text(src)
