@@ -11,9 +11,10 @@ A controller is one module (a built-in in :mod:`auvtrack.control`, or a plug-in 
                    from its own section ``params`` and the :class:`~auvtrack.control.registry.SetupContext`
                    ``ctx``; refuses gains that break its conditions with a one-line ``ValueError``
 ``control``        the compiled law (below)
-``COMMANDS``       optional, ``"tau"`` (default: generalised forces [tau_u, tau_q, tau_r]) or
+``COMMANDS``       optional, ``"tau"`` (default: generalised forces [tau_u, tau_q, tau_r]),
                    ``"actuators"`` (one actuator command per axis, e.g. propeller rpm, stern plane,
-                   rudder on a 6-DOF plant)
+                   rudder on a 6-DOF plant) or both in order of preference (``ctx.commands`` says
+                   which one a run uses)
 ``TRACKS``         optional, ``True`` (default) when it tracks the reference (open-loop inputs: False)
 ``PLANTS``         optional, the plant models it runs on (default: every plant that accepts its commands)
 ``SECTIONS``       optional, other scenario sections it reads (e.g. ``("envelope", "estimator")``)

@@ -167,6 +167,8 @@ class SetupContext:
         The scenario's ``[actuator]`` section (``tau_max``, ``rate_max``) of the 5-DOF plant.
     plant : PlantView
         The plant flown: its actuators and start (for a controller that commands its actuators).
+    commands : str
+        What the law commands on this plant (its ``COMMANDS`` preference the plant accepts).
     sections : dict
         The other scenario sections the controller declared in ``SECTIONS``, by name.
     dt : float
@@ -183,6 +185,7 @@ class SetupContext:
     nu0: tuple = (0.0,) * 5
     actuator: Any = None
     plant: PlantView = field(default_factory=PlantView)
+    commands: str = "tau"
     sections: Mapping[str, Any] = field(default_factory=dict)
     dt: float = 0.001
     control_rate: float = 0.0
@@ -213,8 +216,9 @@ class ControllerSpec:
         One line for listings (the module docstring's first line).
     statuses : dict of int to str
         Messages of the controller's own status codes.
-    commands : str
-        ``"tau"`` or ``"actuators"``.
+    commands : tuple of str
+        What it can command, in order of preference: ``("tau",)``, ``("actuators",)`` or both
+        (``("actuators", "tau")``: the actuators where the plant takes them, tau elsewhere).
     tracks : bool
         Whether it tracks the reference (comparisons and tracking studies take only these).
     plants : tuple of str or None
@@ -233,7 +237,7 @@ class ControllerSpec:
     setup: Callable[..., CompiledController]
     summary: str = ""
     statuses: dict[int, str] = field(default_factory=dict)
-    commands: str = "tau"
+    commands: tuple[str, ...] = ("tau",)
     tracks: bool = True
     plants: tuple[str, ...] | None = None
     sections: tuple[str, ...] = ()
@@ -253,7 +257,22 @@ class ControllerSpec:
         bool
             The plant accepts what the controller commands, and the controller allows the plant.
         """
-        return self.commands in plant.accepts and (self.plants is None or plant.name in self.plants)
+        return self.command_on(plant) is not None and (self.plants is None or plant.name in self.plants)
+
+    def command_on(self, plant) -> str | None:
+        """What it commands on ``plant``: its first preference the plant accepts (None: none).
+
+        Parameters
+        ----------
+        plant : PlantSpec
+            A registered plant.
+
+        Returns
+        -------
+        str or None
+            ``"tau"`` or ``"actuators"``.
+        """
+        return next((c for c in self.commands if c in plant.accepts), None)
 
     @classmethod
     def from_module(cls, module: ModuleType) -> "ControllerSpec":
@@ -358,8 +377,11 @@ def check_controller(module: ModuleType, *, plugin: bool = False) -> ControllerS
     if not callable(module.setup) or len(inspect.signature(module.setup).parameters) != 2:
         raise ValueError(f"{where}: setup must be a function setup(params, ctx)")
     commands = getattr(module, "COMMANDS", "tau")
-    if commands not in COMMAND_KINDS:
-        raise ValueError(f"{where}: COMMANDS must be one of {', '.join(COMMAND_KINDS)} (got {commands!r})")
+    commands = (commands,) if isinstance(commands, str) else commands
+    if not (isinstance(commands, tuple) and commands and all(c in COMMAND_KINDS for c in commands)
+            and len(set(commands)) == len(commands)):
+        raise ValueError(f"{where}: COMMANDS must be one of {', '.join(COMMAND_KINDS)} or a tuple of them in order "
+                         f"of preference (got {getattr(module, 'COMMANDS')!r})")
     tracks = getattr(module, "TRACKS", True)
     if not isinstance(tracks, bool):
         raise ValueError(f"{where}: TRACKS must be True or False (got {tracks!r})")

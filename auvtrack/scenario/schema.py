@@ -562,8 +562,8 @@ class Scenario(BaseModel):
         """The controller can fly the plant (what it commands), and the plant's own cross-checks."""
         plant, ctrl = plant_spec_for(self.plant), controller_spec_for(self.controller)
         if not ctrl.runs_on(plant):
-            which = ("commands " + ("the actuators" if ctrl.commands == "actuators" else "tau")
-                     if ctrl.commands not in plant.accepts else f"runs on plant.model in {list(ctrl.plants or ())}")
+            which = ("commands " + " or ".join("the actuators" if c == "actuators" else c for c in ctrl.commands)
+                     if ctrl.command_on(plant) is None else f"runs on plant.model in {list(ctrl.plants or ())}")
             raise ValueError(f"controller.kind: {self.controller.kind} {which}; plant.model {self.plant.model!r} "
                              f"accepts {' or '.join(plant.accepts)} (choose another plant.model or controller)")
         if plant.check_scenario is not None:

@@ -147,7 +147,7 @@ def prepare(scenario: Scenario) -> Prepared:
     eta0, nu0 = tuple(float(v) for v in sc.initial.eta), tuple(float(v) for v in sc.initial.nu)
     pctx = PlantContext(eta0=eta0, nu0=nu0, phi0=float(sc.initial.phi), p0=float(sc.initial.p), vp_true=vp_true,
                         vehicle_record=record, design_preset=sc.vehicle.preset, actuator=sc.actuator,
-                        commands=cspec.commands, seed=sc.seed)
+                        commands=cspec.command_on(plant_spec), seed=sc.seed)
     cpl = plant_spec.setup(sc.plant, pctx)
     plant_module = cpl.module or plant_spec.module
     ref = build_reference(dict(sc.reference))
@@ -157,7 +157,8 @@ def prepare(scenario: Scenario) -> Prepared:
     p1 = np.array(virtual_point(eta0, attitude(eta0[3], eta0[4]), vp_nom[VP.ell]))
     view = PlantView(plant_module, plant_spec.state, plant_spec.command, _c(cpl.x0), _c(cpl.pp))
     ctx = SetupContext(vp_nom=vp_nom, refm0=refm0, e0=p1 - p0, seed=sc.seed, eta0=eta0, nu0=nu0,
-                       actuator=sc.actuator, plant=view, sections={k: getattr(sc, k) for k in cspec.sections},
+                       actuator=sc.actuator, plant=view, commands=pctx.commands,
+                       sections={k: getattr(sc, k) for k in cspec.sections},
                        dt=sc.sim.dt, control_rate=sc.sim.control_rate)
     cc = cspec.setup(sc.controller, ctx)
     channels = channel_names(cc.aux_names, cpl.log_names)

@@ -26,7 +26,6 @@ Paper eq. (1)-(3); ERRATA points 1, 2, 4.
 """
 from __future__ import annotations
 
-import math
 
 from ..jit import njit
 from ..jit.vecmath import sincos4

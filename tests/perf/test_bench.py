@@ -141,7 +141,7 @@ def test_warmup_covers_every_builtin_controller_on_every_plant_it_runs_on():
     assert {c for c, _ in pairs} == set(BUILTIN_NAMES)
     for c in BUILTIN_NAMES:
         plants = {p for k, p in pairs if k == c}
-        assert plants == {p for p in PLANT_NAMES if CONTROLLERS[c].commands in PLANTS[p].accepts}
+        assert plants == {p for p in PLANT_NAMES if set(CONTROLLERS[c].commands) & set(PLANTS[p].accepts)}
     assert {p for k, p in pairs if k == "open_loop_actuators"} == {"6dof"}
     assert len(kernel_keys(pairs)) == len(pairs)
     assert builtin_pairs(("ftsmc",), ("5dof",)) == [("ftsmc", "5dof")]

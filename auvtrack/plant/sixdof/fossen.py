@@ -274,7 +274,7 @@ def derivative(x, att, vc, dist, cmd, pp, dx):
     xf, yr, zs = fin_forces(math.sqrt(ur * ur + vr * vr), math.sqrt(ur * ur + wr * wr), dr, ds, pp)
     crb = kirchhoff(pp, P_MRB, ur, vr, wr, p, q, r)
     # C_A(nu_r) nu_r with the model's zeroed entries (M_A diagonal): momenta P = M_A11 nu1, L = M_A22 nu2
-    P0, P1, P2 = pp[P_MA] * ur, pp[P_MA + 7] * vr, pp[P_MA + 14] * wr
+    P1, P2 = pp[P_MA + 7] * vr, pp[P_MA + 14] * wr  # (P0 = M_A11 u_r enters none of the terms kept below)
     L0, L1, L2 = pp[P_MA + 21] * p, pp[P_MA + 28] * q, pp[P_MA + 35] * r
     ca = (0.0, -P2 * p, P1 * p, P2 * vr - P1 * wr + L2 * q - L1 * r, -L2 * p + L0 * r, L1 * p - L0 * q)
     fade = math.exp(-3.0 * U_r)
