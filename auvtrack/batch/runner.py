@@ -147,7 +147,8 @@ class BatchInterrupted(KeyboardInterrupt):
 
 
 def _summary(prep: Prepared, cause: int, t_stop: float, out: Outputs) -> RunSummary:
-    failure = None if cause == engine.CAUSE_NONE else failure_record(int(cause), float(t_stop), out.fail_state, prep)
+    failure = None if cause == engine.CAUSE_NONE else failure_record(int(cause), float(t_stop), out.fail_state, prep,
+                                                                     int(out.info[engine.INFO_STATUS]))
     t0, t1 = prep.scenario.metrics.window
     metrics = metrics_finalize(out.acc, t0, min(t1, float(t_stop)))
     return RunSummary(status_of(int(cause)), failure, metrics, float(t_stop), int(out.info[engine.INFO_STEPS]))

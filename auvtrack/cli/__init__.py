@@ -30,7 +30,26 @@ def _details(text: str) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``auvtrack`` console script; returns the exit status."""
+    """Entry point of the ``auvtrack`` console script; returns the exit status.
+
+    When user code (a plug-in's law or plant) was still running when Ctrl-C came and had to be
+    abandoned, the process ends here with ``os._exit`` once everything is written: an interpreter
+    shutting down under running compiled code could crash instead of exiting with 130.
+    """
+    code = _main(argv)
+    from ..interrupt import abandoned
+
+    if abandoned():
+        import os
+        import sys
+
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
+
+
+def _main(argv: list[str] | None) -> int:
     from ..scenario import ScenarioError
 
     warnings.simplefilter("default")

@@ -164,14 +164,19 @@ def _probe(mod, law: str, cc: CompiledController, ctx: SetupContext) -> None:
 
     from ..jit.errors import CompileError, compile_error_line
 
-    checked = numba_njit(boundscheck=True)(mod.control.py_func)
+    from ..interrupt import run_in_thread
+
+    checked = numba_njit(boundscheck=True, nogil=True)(mod.control.py_func)
     try:
-        status, _, _, _ = evaluate(checked, 0.0, ctx.eta0, ctx.nu0, cc.xc0, ctx.refm0, cc.cp, ctx.vp_nom,
-                                   n_aux=len(cc.aux_names))
+        outcome = run_in_thread(lambda: evaluate(checked, 0.0, ctx.eta0, ctx.nu0, cc.xc0, ctx.refm0, cc.cp,
+                                                 ctx.vp_nom, n_aux=len(cc.aux_names)))
     except NumbaError as exc:
         raise CompileError(f"controller.module: {compile_error_line(str(exc), law)}", str(exc)) from None
     except Exception as exc:
         raise ValueError(f"controller.module: {law}: control fails at the initial state: {first_line(exc)}") from None
+    if outcome.interrupted:  # Ctrl-C while the law ran (an endless loop?): stop here
+        raise KeyboardInterrupt
+    status = outcome.value[0]
     if isinstance(status, (bool, np.bool_)) or not isinstance(status, (int, np.integer)):
         raise ValueError(f"controller.module: {law}: control must return an int status "
                          f"(got {type(status).__name__} {status!r})")

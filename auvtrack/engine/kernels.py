@@ -447,9 +447,17 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
                 bar.update(1)
         else:
             shares = _shares(todo, jobs)
-            with ThreadPoolExecutor(max_workers=len(shares)) as pool:
-                for f in [pool.submit(_compile_in_child, share, bar, lanes) for share in shares]:
+            children: list[subprocess.Popen] = []
+            pool = ThreadPoolExecutor(max_workers=len(shares))
+            try:
+                for f in [pool.submit(_compile_in_child, share, bar, lanes, children) for share in shares]:
                     f.result()
+            except BaseException:  # Ctrl-C, or a child failed: end the other children now, not when they finish
+                for proc in children:
+                    proc.kill()
+                raise
+            finally:
+                pool.shutdown(wait=True)
             for k in todo:  # load the cached machine code into this process
                 kernel(k)
     finally:
@@ -472,13 +480,15 @@ def _shares(keys: list[KernelKey], jobs: int) -> list[list[KernelKey]]:
     return [s for s in shares if s]
 
 
-def _compile_in_child(keys: list[KernelKey], bar, lanes: bool = False) -> None:
+def _compile_in_child(keys: list[KernelKey], bar, lanes: bool = False, children: list | None = None) -> None:
     code = ("import sys, json; from auvtrack.engine.kernels import KernelKey, _child_compile; "
             "_child_compile([KernelKey(**k) for k in json.loads(sys.argv[1])], sys.argv[2] == '1')")
     arg = json.dumps([{"law": k.law, "plant": k.plant, "label": k.label} for k in keys])
     with tempfile.TemporaryFile("w+") as errf, subprocess.Popen(
             [sys.executable, "-c", code, arg, "1" if lanes else "0"], stdout=subprocess.PIPE, stderr=errf,
             text=True) as proc:
+        if children is not None:
+            children.append(proc)
         for _ in proc.stdout:  # one line per kernel compiled
             bar.update(1)
         rc = proc.wait()

@@ -59,12 +59,12 @@ from ..jit.lane_values import as_lanes, first_lanes, get_lane
 SI = packed_layout("IntSettings", n_steps=1, log_every=1, ctrl_every=1, n_aux=1)
 """Engine integer settings: RK4 steps, steps per logged row, steps per control sample (0:
 continuous), the controller's channel count."""
-INFO_STOP, INFO_STEPS = 0, 1
-INFO_SIZE = 2
+INFO_STOP, INFO_STEPS, INFO_STATUS = 0, 1, 2
+INFO_SIZE = 3
 STOP_POLL = 1024  # steps between two reads of the stop flag (a power of two)
 
 CAUSE_NONE, CAUSE_NONFINITE, CAUSE_STATE_LIMIT, CAUSE_INTERRUPTED = 0, 1, 3, 4
-CAUSE_CONTROLLER = 10  # + controller status code
+CAUSE_CONTROLLER = 10  # a controller status: the code itself is in info[INFO_STATUS]
 CAUSES = {
     CAUSE_NONFINITE: ("nonfinite", "non-finite state (NaN or Inf)"),
     CAUSE_PITCH: ("pitch_limit", "pitch limit exceeded (|theta| beyond sim.theta_limit)"),
@@ -111,7 +111,8 @@ class Outputs(NamedTuple):
 
     ``log`` (n_rows, n_channels); ``acc`` the metrics accumulator; ``fail_state`` (2, nxp + nxc):
     row 0 the state at the stop, row 1 the last finite state (the state at the start of the
-    failing step); ``info`` int64 (INFO_*): the stop request (read) and the steps run (written).
+    failing step); ``info`` int64 (INFO_*): the stop request (read), the steps run and the
+    controller's failure status (written).
     """
 
     log: np.ndarray
@@ -393,7 +394,8 @@ def run(pb, cb, env, ref_p, settings, out):
                 status = STATUS_NONFINITE_INPUT
             if status != 0:
                 record_stop(xp, xc, xp, xc, fail_state)
-                return CAUSE_CONTROLLER + status, row, t
+                info[INFO_STATUS] = status
+                return CAUSE_CONTROLLER, row, t
             sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt, cmd_sample)
             for i in range(cmd_sample.shape[0]):
                 cmd[i] = cmd_sample[i]
@@ -408,7 +410,8 @@ def run(pb, cb, env, ref_p, settings, out):
             status = STATUS_NONFINITE_INPUT
         if status != 0:
             record_stop(xp, xc, xp, xc, fail_state)
-            return CAUSE_CONTROLLER + status, row, t
+            info[INFO_STATUS] = status
+            return CAUSE_CONTROLLER, row, t
         applied = plant.applied(xp, cmd, pp)
         eta, nu = plant.pose(xp)
         p1 = virtual_point(eta, att, vp[VP.ell])
@@ -440,7 +443,8 @@ def run(pb, cb, env, ref_p, settings, out):
             status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, LawOutputs(tau, kc4, aux), True)
         if status != 0:
             record_stop(xp, xc, xp, xc, fail_state)
-            return CAUSE_CONTROLLER + status, row, t
+            info[INFO_STATUS] = status
+            return CAUSE_CONTROLLER, row, t
         for i in range(nxp):
             xpn[i] = xp[i] + dt / 6.0 * (kp1[i] + 2.0 * kp2[i] + 2.0 * kp3[i] + kp4[i])
         for i in range(nxc):

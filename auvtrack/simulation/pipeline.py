@@ -31,7 +31,8 @@ from ..reference import build_reference
 from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
 from ..scenario.plan import plan_run
-from ..user_modules import load_module
+from ..interrupt import Outcome, run_in_thread
+from ..user_modules import first_line, load_module
 from ..engine import loop as engine
 from ..engine import kernels
 from ..channels import BASE_CHANNELS, LOG_ROW, channel_names
@@ -221,37 +222,6 @@ def call_kernel(prep: Prepared, out: Outputs) -> tuple[int, int, float]:
     return int(cause), int(rows), float(t_stop)
 
 
-def _in_worker_thread(fn, stop: np.ndarray):
-    """Run ``fn()`` in a thread so that Ctrl-C reaches this (main) thread; on Ctrl-C set the stop flag.
-
-    The wait is on an Event, not on ``Thread.join``: a ``join`` interrupted by Ctrl-C can report
-    the thread finished while it still runs (CPython 3.11), and the result would be lost.
-    """
-    box: dict[str, Any] = {}
-    done = threading.Event()
-
-    def target():
-        try:
-            box["value"] = fn()
-        except BaseException as exc:  # pragma: no cover - re-raised below
-            box["error"] = exc
-        finally:
-            done.set()
-
-    th = threading.Thread(target=target, name="auvtrack-run", daemon=True)
-    th.start()
-    interrupted = False
-    while not done.is_set():
-        try:
-            done.wait(0.05)
-        except KeyboardInterrupt:
-            stop[engine.INFO_STOP] = 1
-            interrupted = True
-    if "error" in box:
-        raise box["error"]
-    return box["value"], interrupted
-
-
 def run_prepared(prep: Prepared) -> Result:
     """Run the compiled engine on prepared arrays and wrap the outcome in a :class:`Result`.
 
@@ -275,20 +245,61 @@ def run_prepared(prep: Prepared) -> Result:
     ensure_compiled([prep])
     out = outputs_for(prep)
     wall = time.perf_counter()
+
+    def stop() -> None:
+        out.info[engine.INFO_STOP] = 1
+
     if threading.current_thread() is threading.main_thread():
-        (cause, rows, t_stop), interrupted = _in_worker_thread(lambda: call_kernel(prep, out), out.info)
+        outcome = run_in_thread(lambda: call_kernel(prep, out), stop, reraise=False)
     else:
-        (cause, rows, t_stop), interrupted = call_kernel(prep, out), False
+        try:
+            outcome = Outcome(call_kernel(prep, out), False, False)
+        except Exception as exc:  # a law or plant that raised inside the compiled loop
+            outcome = Outcome(exc, False, False)
     wall = time.perf_counter() - wall
+    if outcome.abandoned:  # the law or plant never returned to the loop: keep what it logged
+        result = _partial(prep, out, wall, "interrupted",
+                          "interrupted by the user; the run did not stop at the request (the law or plant was still "
+                          "computing) and was abandoned")
+        result.meta["abandoned"] = True
+        raise SimulationInterrupted(result)
+    if isinstance(outcome.value, BaseException):
+        exc = outcome.value
+        if not isinstance(exc, Exception):
+            raise exc
+        return _partial(prep, out, wall, "exception", first_line(exc))
+    cause, rows, t_stop = outcome.value
     result = result_from(prep, out, cause, rows, t_stop, wall)
-    if interrupted or cause == engine.CAUSE_INTERRUPTED:
+    if outcome.interrupted or cause == engine.CAUSE_INTERRUPTED:
         raise SimulationInterrupted(result)
     return result
 
 
+def _partial(prep: Prepared, out: Outputs, wall: float, cause: str, detail: str) -> Result:
+    """The result of a run that left the compiled loop without a stop cause: what it logged, a failure record.
+
+    The rows logged are those whose time is written; the state named is the last logged one.
+    """
+    rows = int(np.count_nonzero(np.isfinite(out.log[:, 0]))) if out.log.shape[0] else 0
+    steps = int(out.info[engine.INFO_STEPS])
+    t = steps * float(prep.settings.sf[SF.dt])
+    sc = prep.scenario
+    channels = {name: out.log[:rows, j].copy() for j, name in enumerate(prep.channels)}
+    state = {n: float(channels[n][-1]) for n in STATE_NAMES} if rows else {}
+    failure = {"time": t, "cause": cause, "detail": detail, "state": state}
+    resolved = sc.to_dict()
+    resolved["resolved"] = prep.resolved
+    t0, t1 = sc.metrics.window
+    metrics = metrics_finalize(out.acc, t0, min(t1, t))
+    meta = {"version": __version__, "wall_time_s": wall, "notes": list(prep.notes), "steps": steps,
+            "steps_planned": prep.n_steps}
+    return Result(channels, resolved, "interrupted" if cause == "interrupted" else "failed", failure, metrics, meta)
+
+
 def result_from(prep: Prepared, out: Outputs, cause: int, rows: int, t_stop: float, wall: float) -> Result:
     """Wrap a finished kernel call in a :class:`Result` (trajectory, metrics, status, failure, meta)."""
-    failure = None if cause == engine.CAUSE_NONE else failure_record(cause, t_stop, out.fail_state, prep)
+    failure = None if cause == engine.CAUSE_NONE else failure_record(cause, t_stop, out.fail_state, prep,
+                                                                     int(out.info[engine.INFO_STATUS]))
     sc = prep.scenario
     t0, t1 = sc.metrics.window
     metrics = metrics_finalize(out.acc, t0, min(t1, t_stop))
@@ -307,35 +318,72 @@ def status_of(cause: int) -> str:
     return "interrupted" if cause == engine.CAUSE_INTERRUPTED else "failed"
 
 
-def failure_record(cause: int, t: float, fail_state: np.ndarray, prep: Prepared) -> dict[str, Any]:
+def failure_record(cause: int, t: float, fail_state: np.ndarray, prep: Prepared, status: int = 0) -> dict[str, Any]:
     """The ``Result.failure`` record of a stop: time, cause, detail, state and last finite state.
 
     Parameters
     ----------
     cause : int
-        Kernel stop cause (``engine.CAUSE_*`` or ``CAUSE_CONTROLLER`` + status).
+        Kernel stop cause (``engine.CAUSE_*``).
     t : float
         Stop time (s).
     fail_state : numpy.ndarray
         (2, n): the state at the stop and the last finite state.
     prep : Prepared
-        The run (for channel names and status messages).
+        The run (for state names and status messages).
+    status : int, optional
+        The controller's status for ``CAUSE_CONTROLLER``.
 
     Returns
     -------
     dict
-        ``time``, ``cause``, ``detail``, ``state`` and, when they differ, ``last_finite_state``.
+        ``time``, ``cause``, ``detail`` (for a divergence: the component that blew up first),
+        ``state`` and, when they differ, ``last_finite_state``.
     """
-    if cause >= engine.CAUSE_CONTROLLER:
+    if cause == engine.CAUSE_CONTROLLER:
         name = "controller"
-        status = cause - engine.CAUSE_CONTROLLER
-        detail = prep.statuses.get(status, f"status {status}")
+        detail = prep.statuses.get(status) or (
+            f"status {status}" if status > 0 else f"the controller returned status {status} (statuses are codes > 0)")
     else:
-        name, detail = engine.CAUSES[cause]
+        name, detail = engine.CAUSES.get(cause, ("engine", f"unknown stop cause {cause}"))
+        if cause in (engine.CAUSE_NONFINITE, engine.CAUSE_STATE_LIMIT):
+            detail += f"; first: {_blown_component(fail_state[0], prep)}"
     record = {"time": float(t), "cause": name, "detail": detail, "state": _state_dict(fail_state[0], prep)}
     if not np.array_equal(fail_state[0], fail_state[1], equal_nan=True):
         record["last_finite_state"] = _state_dict(fail_state[1], prep)
     return record
+
+
+def _state_names(prep: Prepared) -> list[str]:
+    """A name for each component of the stacked [plant state, controller state]."""
+    from ..control import spec_for
+    from ..plant import spec_for as plant_spec
+
+    plant = list(plant_spec(prep.scenario.plant).state) or [f"plant state {i}" for i in range(prep.plant.x0.size)]
+    layout = getattr(load_module(spec_for(prep.scenario.controller).module), "STATE", None)
+    names = []
+    for i in range(prep.controller.x0.size):
+        field = None
+        if layout is not None and hasattr(layout, "sizes"):
+            for f, size in layout.sizes.items():
+                start = getattr(layout, f)
+                if start <= i and (size is None or i < start + size):
+                    field = f"{f}[{i - start}]"
+        names.append(f"controller state {field or i}")
+    return plant + names
+
+
+def _blown_component(state: np.ndarray, prep: Prepared) -> str:
+    """The component that is non-finite, else the one beyond sim.state_limit, named, with its value."""
+    names = _state_names(prep)
+    bad = [i for i, v in enumerate(state) if not np.isfinite(v)]
+    if not bad:
+        bad = [i for i, v in enumerate(state) if abs(v) > prep.scenario.sim.state_limit]
+    if not bad:
+        return "none"
+    i = bad[0]
+    more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+    return f"{names[i] if i < len(names) else i} = {state[i]:.6g}{more}"
 
 
 def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
