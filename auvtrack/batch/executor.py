@@ -122,6 +122,14 @@ class ChunkJob:
         """A few words naming the job a manifest records (for the message refusing another job's folder)."""
         return str(manifest.get("name", "?"))
 
+    def format1_fingerprint(self) -> str | None:
+        """The fingerprint a format-1 manifest (chunks without metadata) records for this job, if it has one.
+
+        Such a folder is accepted with ``resume``; its chunks carry no fingerprint, so each is
+        recomputed.
+        """
+        return None
+
     # ---------------------------------------------------------------- how a chunk is computed
     def warm_local(self, workers: int | None) -> float:
         """Compile or load what the local runs need before they are timed; the seconds it took."""
@@ -233,6 +241,8 @@ def _check_folder(job: ChunkJob, out: Path, fp: str, resume: bool) -> list[int]:
         old = _read_manifest(man)
         if old is None:
             raise err(f"--out: {man}: is not the {job.manifest_name} of an auvtrack {job.kind}; choose another folder")
+        if "format" not in old and old["fingerprint"] == job.format1_fingerprint():
+            old = {**old, "fingerprint": fp}  # this job in format 1: resumable, every chunk recomputed
         if old["fingerprint"] != fp:
             if old.get("definition") == job.definition_hash():
                 why = "another version of the auvtrack sources"

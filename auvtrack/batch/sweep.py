@@ -124,6 +124,10 @@ class SweepJob(ChunkJob):
         """The study file another sweep's manifest names."""
         return f"study {manifest.get('name', '?')!r} from {manifest.get('source', '?')}"
 
+    def format1_fingerprint(self) -> str:
+        """The study's fingerprint, which format-1 manifests record."""
+        return self.spec.fingerprint()
+
     def run_local(self, ids: range, workers: int | None):
         """The samples ``ids`` run in this process (one core, as on a worker)."""
         from .sweep_worker import run_samples

@@ -407,6 +407,15 @@ class CompareJob(ChunkJob):
                 f"{', '.join(labels) or '?'}, chunk size {manifest.get('chunk_size', '?')}, back end "
                 f"{manifest.get('backend') or 'default'}")
 
+    def format1_fingerprint(self) -> str:
+        """SHA-256 of suite, controllers, chunk size, sources and named back end: what format-1 manifests record."""
+        import hashlib
+
+        from ..jit import source_hash
+
+        doc = {**self.definition(), "source": source_hash()}
+        return hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()
+
     def warm_local(self, workers: int | None) -> float:
         """:func:`_warm` of one run per (controller, tier, plant preset)."""
         return _warm(_warm_specs(self.suite, self.entries), workers, self.backend)
