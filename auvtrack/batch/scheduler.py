@@ -65,9 +65,9 @@ def probe_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT_S) -> None:
     SchedulerError
         Nothing listens there, nothing answers, or what answers is not a Dask scheduler.
     """
+    if address.partition("://")[0] not in ("tcp", "tls") and "://" in address:
+        return  # inproc://, ucx://, ws://...: left to the client's own bounded timeout
     scheme, host, port = _host_port(address)
-    if scheme not in ("tcp", "tls"):
-        return
     try:
         sock = socket.create_connection((host, port), timeout=timeout)
     except socket.gaierror as exc:
