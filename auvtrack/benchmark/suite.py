@@ -242,7 +242,8 @@ def check_competitor(entry: "ControllerEntry") -> None:
         try:
             _, spec = load(module)
         except ValueError as exc:
-            raise SuiteError(f"--plugin: {module}: {' '.join(str(exc).split())}") from None
+            why = " ".join(str(exc).split())
+            raise SuiteError(f"--plugin: {why}" if module in why else f"--plugin: {module}: {why}") from None
         if not spec.tracks:
             raise SuiteError(f"--plugin: {module}: does not track a reference (TRACKS = False); "
                              "a comparison is of tracking controllers")

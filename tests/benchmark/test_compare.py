@@ -303,6 +303,7 @@ def test_shipped_suite_is_sized_for_its_failure_interval():
 
 def test_ctrl_c_keeps_the_finished_chunks_and_resume_finishes(tiny, tmp_path):
     import os
+    import shlex
     import signal
     import subprocess
     import sys
@@ -324,8 +325,11 @@ def test_ctrl_c_keeps_the_finished_chunks_and_resume_finishes(tiny, tmp_path):
     assert "--resume" in err and "Traceback" not in err
     kept = sorted((out / "chunks").glob("chunk-*.parquet"))
     assert 1 <= len(kept) < 10 and not (out / "runs.parquet").exists()
-    res = compare(path, out=out, progress=False, resume=True)
-    assert res.complete and res.execution.chunks_skipped == len(kept)
+    command = err.strip().splitlines()[-1].split("the finished chunks are kept: ", 1)[1]
+    argv = shlex.split(command)  # the printed command, run verbatim
+    assert argv[:2] == ["auvtrack", "compare"] and argv[-1] == "--resume"
+    assert main([*argv[1:], "--quiet"]) == 0
+    assert json.loads((out / "results.json").read_text())["timing"]["chunks_resumed"] == len(kept)
     runs = pd.read_parquet(out / "runs.parquet")
     assert sorted(runs["run"]) == list(range(len(resolve_controllers()) * 2 * 2 * 60))
 
