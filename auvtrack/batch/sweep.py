@@ -200,7 +200,11 @@ def _client(workers: int | None, scheduler: str | None, memory_limit: str | int)
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                                memory_limit=parse_memory(memory_limit), env={"NUMBA_NUM_THREADS": "1"},
                                silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+    client = Client(cluster)
+    from .sweep_worker import IgnoreInterruptsPlugin
+
+    client.register_plugin(IgnoreInterruptsPlugin(), name=IgnoreInterruptsPlugin.name)  # Ctrl-C is the client's
+    return client, cluster
 
 
 def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | None = None,

@@ -2,9 +2,10 @@
 
 The first SIGINT or SIGTERM raises ``KeyboardInterrupt`` in the main thread, so the command
 stops its work, closes its Dask cluster or its batch and keeps what it finished.  Later signals
-are ignored until the command returns: a second Ctrl-C while a cluster closes would otherwise
-interrupt Dask's event loop in the middle of its shutdown and print an asyncio
-``CancelledError`` traceback instead of the one-line message.
+are ignored until the process exits: a second Ctrl-C while a cluster closes would otherwise
+interrupt the shutdown and print a traceback instead of the one-line message.  (The workers of
+a cluster the command starts ignore SIGINT themselves:
+:class:`auvtrack.batch.sweep_worker.IgnoreInterruptsPlugin`.)
 """
 from __future__ import annotations
 
@@ -25,7 +26,9 @@ def stop_once() -> Iterator[None]:
     Yields
     ------
     None
-        The previous handlers are restored on exit.
+        The previous handlers are restored on exit, unless a signal stopped the command: the
+        process is then ending (its clean-up at exit closes Dask's loops too), and both
+        signals stay ignored until it exits.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -42,5 +45,5 @@ def stop_once() -> Iterator[None]:
     try:
         yield
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        for sig, handler in previous.items():  # once stopping, the process is ending: stay deaf until it exits
+            signal.signal(sig, signal.SIG_IGN if stopping else handler)

@@ -328,7 +328,7 @@ def test_ctrl_c_keeps_the_finished_chunks_and_resume_finishes(tiny, tmp_path):
     command = err.strip().splitlines()[-1].split("the finished chunks are kept: ", 1)[1]
     argv = shlex.split(command)  # the printed command, run verbatim
     assert argv[:2] == ["auvtrack", "compare"] and argv[-1] == "--resume"
-    assert main([*argv[1:], "--quiet"]) == 0
+    assert main(argv[1:]) == 0
     assert json.loads((out / "results.json").read_text())["timing"]["chunks_resumed"] == len(kept)
     runs = pd.read_parquet(out / "runs.parquet")
     assert sorted(runs["run"]) == list(range(len(resolve_controllers()) * 2 * 2 * 60))
