@@ -36,7 +36,7 @@ RUNS_FILE = "runs.parquet"
 FIXED_COLUMNS = ("run", "controller", "task", "tier", "seed_index", "seed", "status", "cause", "detail",
                  "fail_time", "t_stop", "steps", "draws")
 DEFAULT_MAX_RUNS = 100_000
-"""Default bound on the runs of one comparison (``--max-runs``): 8 x the default suite's 12 000."""
+"""Default bound on the runs of one comparison (``--max-runs``): about 8 x the default suite's."""
 MAX_RUNS = 1_000_000
 """Hard ceiling of ``--max-runs`` (the runs table and its statistics are held in memory)."""
 

@@ -166,3 +166,26 @@ def test_ctrl_c_twice_closes_the_cluster_without_a_traceback_and_resume_finishes
     assert q.returncode == 0, q.stderr
     df = read_results(out)
     assert df["sample"].tolist() == list(range(30)) and (df["status"] == "ok").all()
+
+
+def test_the_limits_table_and_messages_of_the_docs_are_the_code_s(tmp_path, monkeypatch):
+    """docs/sweeps.md's [limits] rows are StudyLimits' defaults and ceilings; its example lines are the messages."""
+    import re
+
+    from auvtrack.batch import sweep_spec
+    from auvtrack.batch.sweep_spec import StudyError, StudyLimits, load_study
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "sweeps.md").read_text()
+    rows = dict((k, (int(d), int(c))) for k, d, c in re.findall(r"^\| `(max_\w+)` \| (\d+) \| (\d+) \|", doc, re.M))
+    ceilings = {"max_samples": sweep_spec.MAX_SAMPLES, "max_grid_values": sweep_spec.MAX_GRID_VALUES,
+                "max_chunks": sweep_spec.MAX_CHUNK_FILES}
+    assert rows == {k: (f.default, ceilings[k]) for k, f in StudyLimits.model_fields.items()}
+    for field in StudyLimits.model_fields.values():  # the model refuses what the ceiling says
+        assert [m.le for m in field.metadata if hasattr(m, "le")][0] in ceilings.values()
+    monkeypatch.chdir(tmp_path)
+    text = STUDY.replace("{seed}", "3")
+    for old, new in [("samples = 8", "samples = 90000000"), ("[random.", GRID + "[random.")]:
+        Path("big.toml").write_text(text.replace(old, new, 1))
+        with pytest.raises(StudyError) as info:
+            load_study("big.toml")
+        assert f"auvtrack: error: {info.value}\n" in doc

@@ -201,3 +201,14 @@ def test_an_out_folder_of_the_user_s_own_files_is_refused_and_left_alone(tmp_pat
         err = capsys.readouterr().err
         assert f"--out: {mine} already holds files that are not an auvtrack comparison (thesis.tex)" in err, err
     assert [p.name for p in mine.iterdir()] == ["thesis.tex"]
+
+
+def test_the_plan_bounds_of_the_docs_are_the_code_s():
+    text = (Path(__file__).resolve().parents[2] / "docs" / "benchmark.md").read_text()
+    assert (f"`--max-runs` (default {runner.DEFAULT_MAX_RUNS}, about 8 × the default suite; at most {runner.MAX_RUNS})"
+            in text)
+    suite = load_suite()
+    assert round(runner.DEFAULT_MAX_RUNS / runner.plan_size(suite, resolve_controllers())) == 8
+    from auvtrack.batch.executor import MAX_WORKERS
+
+    assert f"`--workers`\n  is at most {MAX_WORKERS}." in text
