@@ -189,3 +189,13 @@ def test_the_limits_table_and_messages_of_the_docs_are_the_code_s(tmp_path, monk
         with pytest.raises(StudyError) as info:
             load_study("big.toml")
         assert f"auvtrack: error: {info.value}\n" in doc
+
+
+def test_the_executor_runs_a_sweep_locally_with_the_rows_of_dask(tmp_path, reference):
+    from auvtrack.batch.executor import execute_chunks
+    from auvtrack.batch.sweep import SweepJob
+    from auvtrack.batch.sweep_spec import load_study
+
+    res = execute_chunks(SweepJob(load_study(study(tmp_path))), tmp_path / "local", progress=False)
+    assert res.complete and res.chunks_run == 4
+    pd.testing.assert_frame_equal(read_results(tmp_path / "local"), reference)

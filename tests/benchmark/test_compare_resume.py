@@ -212,3 +212,43 @@ def test_the_plan_bounds_of_the_docs_are_the_code_s():
     from auvtrack.batch.executor import MAX_WORKERS
 
     assert f"`--workers`\n  is at most {MAX_WORKERS}." in text
+
+
+def test_any_range_of_runs_is_planned_as_the_whole_plan_plans_it(tmp_path):
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    suite = load_suite(_suite(tmp_path))
+    entries = resolve_controllers(["ftsmc", "pid", "sta"])
+    whole = runner.plan_runs(suite, entries)
+    assert len(whole) == runner.plan_size(suite, entries) == 2 * 2 * 3 * 3
+    assert [s.run for s in whole] == list(range(len(whole)))
+
+    @settings(max_examples=40, deadline=None)
+    @given(st.integers(0, len(whole)), st.integers(0, len(whole)))
+    def check(a, b):
+        assert runner.plan_runs(suite, entries, range(min(a, b), max(a, b))) == whole[min(a, b):max(a, b)]
+
+    check()
+    with pytest.raises(IndexError):
+        runner.plan_runs(suite, entries, range(len(whole), len(whole) + 1))
+
+
+def test_the_warm_up_flies_the_first_run_of_every_controller_tier_and_plant_preset():
+    suite = load_suite().quick_variant()
+    entries = resolve_controllers()
+    first: dict[tuple, runner.RunSpec] = {}
+    for s in runner.plan_runs(suite, entries):
+        first.setdefault((s.controller, s.tier, s.overrides.get("plant.preset")), s)
+    warm = runner._warm_specs(suite, entries)
+    assert {(s.controller, s.tier, s.overrides.get("plant.preset")): s for s in warm} == first
+    assert {k[2] for k in first if k[1] == "truth6"} == {"remus100_prestero", "remus100_fossen"}
+
+
+def test_a_run_lost_with_its_worker_is_a_failed_row_of_the_schema(tmp_path):
+    job = runner.CompareJob(load_suite(_suite(tmp_path)), resolve_controllers(["ftsmc"]), 4, None)
+    t = job.lost_rows(range(2, 4), "the worker process died")
+    assert t.schema.equals(job.schema()) and t.column("run").to_pylist() == [2, 3]
+    assert set(t.column("status").to_pylist()) == {"failed"} and set(t.column("cause").to_pylist()) == {"worker_died"}
+    planned = runner.plan_runs(job.suite, job.entries, range(2, 4))
+    assert t.column("seed").to_pylist() == [int(s.raw["seed"]) for s in planned]
