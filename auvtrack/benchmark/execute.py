@@ -27,7 +27,7 @@ from typing import Any, Callable, Sequence
 from ..batch.chunk_files import chunk_path
 from ..batch.executor import ChunkJob, check_workers, execute_chunks
 
-__all__ = ["RunSpec", "plan_size", "check_plan", "plan_runs", "run_planned", "run_chunk", "execute", "ExecOutcome",
+__all__ = ["RunSpec", "plan_size", "check_plan", "check_plugin_setups", "plan_runs", "run_planned", "run_chunk", "execute", "ExecOutcome",
            "CompareJob", "CompareError", "chunk_path", "MANIFEST", "RUNS_FILE", "FIXED_COLUMNS", "DEFAULT_MAX_RUNS",
            "MAX_RUNS"]
 
@@ -175,18 +175,64 @@ def _schema():
 
 
 def _prepare(spec: RunSpec):
-    """A Prepared run, or the one-line reason the controller's set-up refused it."""
+    """A Prepared run, or the one-line reason the controller's set-up refused it.
+
+    A plug-in's set-up is user code: any exception it raises is its refusal of the run (with the
+    exception's type), never a traceback in the middle of a comparison.
+    """
     import warnings
 
     from ..scenario import ScenarioError, load_scenario
     from ..simulation.pipeline import prepare
 
+    refusals = Exception if spec.raw.get("controller", {}).get("kind") == "plugin" else (
+        ScenarioError, ValueError, ImportError, TypeError)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return prepare(load_scenario(spec.raw, spec.overrides))
-    except (ScenarioError, ValueError, ImportError, TypeError) as exc:
-        return " ".join(str(exc).split()) or type(exc).__name__
+    except refusals as exc:
+        text = " ".join(str(exc).split()) or type(exc).__name__
+        return text if isinstance(exc, ValueError) else f"{type(exc).__name__}: {text}"
+
+
+def check_plugin_setups(suite, entries: Sequence) -> None:
+    """Refuse a plug-in whose set-up breaks (raises anything but a refusal) on the comparison's first run.
+
+    The contract's way to refuse a run is a ``ValueError`` (a gain condition); such a run counts
+    as a set-up failure.  Any other exception on the first (tier, task, seed 0) is a broken
+    plug-in, and the comparison stops before anything runs.
+
+    Parameters
+    ----------
+    suite : auvtrack.benchmark.suite.Suite
+        The suite.
+    entries : sequence of ControllerEntry
+        The competitors (only plug-ins are probed).
+
+    Raises
+    ------
+    CompareError
+        One line naming ``--plugin``, the file and the exception.
+    """
+    import warnings
+
+    from ..scenario import load_scenario
+    from ..simulation.pipeline import prepare
+
+    for e in entries:
+        if e.table.get("kind") != "plugin":
+            continue
+        spec = plan_runs(suite, [e], range(1))[0]
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                prepare(load_scenario(spec.raw, spec.overrides))
+        except ValueError:
+            pass  # a refusal of this run (ScenarioError is one): recorded as a set-up failure
+        except Exception as exc:  # noqa: BLE001 - the plug-in's own code
+            raise CompareError(f"--plugin: {e.table.get('module')}: its set-up fails on task {spec.task}, tier "
+                               f"{spec.tier}: {type(exc).__name__}: {' '.join(str(exc).split())}") from None
 
 
 def _backend_kw(backend: str | None) -> dict:
@@ -515,8 +561,9 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
     Raises
     ------
     CompareError
-        A plan over ``max_runs``, an output folder of another comparison or holding other files,
-        existing chunks without ``resume``, a ``--scheduler`` where no Dask scheduler answers.
+        A plan over ``max_runs``, a plug-in whose set-up breaks on the first run, an output folder
+        of another comparison or holding other files, existing chunks without ``resume``, a
+        ``--scheduler`` where no Dask scheduler answers.
     auvtrack.batch.runner.BatchInterrupted
         Ctrl-C during a local chunk (the chunks written so far stay, for ``resume``).
     """
@@ -529,6 +576,7 @@ def execute(suite, entries: Sequence, out: str | Path, *, resume: bool = False, 
         if backend not in BACKENDS:
             raise CompareError(f"--backend: must be one of {', '.join(BACKENDS)} (got {backend!r})")
     check_plan(suite, entries, max_runs)
+    check_plugin_setups(suite, entries)
     job = CompareJob(suite, entries, chunk_size, backend)
     hook = None if on_chunk is None else (lambda written, _client: on_chunk(written))
     res = execute_chunks(job, out, resume=resume, client=client, scheduler=scheduler, workers=workers,

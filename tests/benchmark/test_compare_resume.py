@@ -191,6 +191,25 @@ def test_a_plugin_that_does_not_import_or_track_is_refused_before_anything_runs(
     assert err.count("\n") == 1 and not (tmp_path / "x").exists() and time.monotonic() - t0 < 60
 
 
+def test_a_plugin_whose_setup_breaks_is_refused_before_anything_runs(tmp_path, capsys):
+    broken = tmp_path / "broken_setup.py"
+    broken.write_text(PLUGIN.read_text() + "\n\ndef setup(params, ctx):\n    raise KeyError('gains')\n")
+    code = main(["compare", "--suite", str(_suite(tmp_path)), "--quick", "--controllers", "ftsmc", "--plugin",
+                 str(broken), "--out", str(tmp_path / "x"), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith(f"auvtrack: error: --plugin: {broken}: its set-up fails on task helix, tier calm: KeyError"), err
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_plugin_s_exception_in_a_run_is_that_run_s_setup_failure(tmp_path):
+    broken = tmp_path / "broken_setup.py"
+    broken.write_text(PLUGIN.read_text() + "\n\ndef setup(params, ctx):\n    raise KeyError('gains')\n")
+    entry = ControllerEntry("broken", {"kind": "plugin", "module": str(broken)}, "")
+    spec, = runner.plan_runs(load_suite(_suite(tmp_path)), [entry], range(1))
+    assert runner._prepare(spec) == "KeyError: 'gains'"  # recorded as the run's set-up failure, not raised
+
+
 def test_an_out_folder_of_the_user_s_own_files_is_refused_and_left_alone(tmp_path, capsys):
     mine = tmp_path / "mine"
     mine.mkdir()
