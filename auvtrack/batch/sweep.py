@@ -244,6 +244,8 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
     Returns
     -------
     SweepOutcome
+        Whether the sweep is complete (then with its summary), chunks run, kept and recomputed,
+        and the time the chunks took.
 
     Raises
     ------

@@ -63,6 +63,17 @@ API = [
     "auvtrack.benchmark.leaderboard.paired_comparisons",
     "auvtrack.benchmark.execute.execute",
     "auvtrack.benchmark.execute.run_chunk",
+    "auvtrack.benchmark.execute.run_planned",
+    "auvtrack.benchmark.execute.plan_runs",
+    "auvtrack.benchmark.execute.check_plan",
+    "auvtrack.batch.executor.execute_chunks",
+    "auvtrack.batch.executor.check_workers",
+    "auvtrack.batch.chunk_files.check_chunk",
+    "auvtrack.batch.chunk_files.table_digest",
+    "auvtrack.batch.chunk_files.write_chunk",
+    "auvtrack.batch.scheduler.connect_scheduler",
+    "auvtrack.batch.scheduler.probe_scheduler",
+    "auvtrack.batch.sweep.run_sweep",
 ]
 
 
