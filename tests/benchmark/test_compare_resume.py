@@ -271,3 +271,16 @@ def test_a_run_lost_with_its_worker_is_a_failed_row_of_the_schema(tmp_path):
     assert set(t.column("status").to_pylist()) == {"failed"} and set(t.column("cause").to_pylist()) == {"worker_died"}
     planned = runner.plan_runs(job.suite, job.entries, range(2, 4))
     assert t.column("seed").to_pylist() == [int(s.raw["seed"]) for s in planned]
+
+
+def test_a_comparison_on_a_cluster_without_workers_stops_with_a_diagnostic(tmp_path, monkeypatch):
+    from distributed import Client, LocalCluster
+
+    from auvtrack.batch import dask_wait
+
+    monkeypatch.setattr(dask_wait, "WORKER_GRACE_S", 1.0)
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=":0") as cluster, Client(cluster) as client:
+        t0 = time.monotonic()
+        with pytest.raises(runner.CompareError, match=r"no worker for 1 s .* 0 of 8 chunks are kept .*--resume"):
+            _run(_suite(tmp_path), tmp_path / "o", client=client)
+        assert time.monotonic() - t0 < 30
