@@ -14,33 +14,8 @@ from auvtrack.benchmark import execute as runner
 from auvtrack.benchmark.compare import compare
 from auvtrack.benchmark.suite import ControllerEntry, SuiteError, load_suite, resolve_controllers, tracking_kinds
 from auvtrack.cli import EXIT_BAD_INPUT, main
+from tiny_suite import TINY as SUITE
 
-SUITE = """
-name = "tiny"
-version = 1
-seed = 5
-seeds = 3
-bootstrap_resamples = 200
-[base]
-"vehicle.preset" = "remus100"
-"sim.dt" = 0.002
-"disturbance" = []
-[quick]
-seeds = 2
-duration = 1.0
-[tasks.helix]
-duration = 3.0
-reference = { kind = "helix", radius = 10.0, omega = 0.1, climb = -0.25, center = [0.0, 0.0, 20.0] }
-[tasks.line]
-duration = 2.0
-reference = { kind = "line", start = [0.0, 0.0, 5.0], velocity = [1.0, 0.0, 0.0] }
-[tiers.calm]
-start = { lateral = 0.3 }
-[tiers.model]
-start = { lateral = 1.0, heading = 0.2 }
-[tiers.model.random]
-"uncertainty.M" = { dist = "uniform", low = -0.2, high = 0.2 }
-"""
 RUNS = 2 * 2 * 2  # tiers x tasks x quick seeds, one controller
 
 
