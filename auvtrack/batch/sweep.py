@@ -1,12 +1,14 @@
 """``auvtrack sweep``: parameter sweeps and Monte Carlo studies on Dask distributed.
 
 The study (:mod:`auvtrack.batch.sweep_spec`) is cut into chunks of ``chunk_size`` samples;
-each chunk is one Dask task (:func:`auvtrack.batch.sweep_worker.run_chunk`) that runs its
-samples through the batch runner and returns an Arrow table.  The client writes each completed
-chunk as ``chunks/chunk-NNNNNN.parquet`` atomically (temporary file + rename), so
+:class:`SweepJob` hands it to the chunk executor (:mod:`auvtrack.batch.executor`): each chunk is
+one Dask task (:func:`auvtrack.batch.sweep_worker.run_samples`) that runs its samples through
+the batch runner and returns an Arrow table, written by the client as
+``chunks/chunk-NNNNNN.parquet`` atomically with the sweep's fingerprint and its content hash, so
 
-* ``resume=True`` skips every chunk whose file exists and finishes with each sample once;
-* a worker that dies mid-chunk costs nothing: Dask reruns the task, and the task is pure;
+* ``resume=True`` keeps every chunk that passes verification, recomputes the others (each
+  named on one line) and finishes with each sample exactly once;
+* a worker that dies mid-chunk costs nothing: its samples run again, one at a time;
 * a sample's row depends only on its index and the study, never on chunking or worker.
 
 At the end every chunk is combined into ``results.parquet`` (streamed, memory flat in the
@@ -17,22 +19,20 @@ from __future__ import annotations
 import json
 import logging
 import math
-import time
-import uuid
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from .._atomic import atomic_file, atomic_write
-from .dask_wait import ClusterLost
+from .._atomic import atomic_write
+from .chunk_files import chunk_path
+from .executor import ChunkJob, check_workers, execute_chunks
 from .sweep_spec import StudyError, StudySpec, load_study
 
 MANIFEST = "study.json"
-CHUNK_DIR = "chunks"
 RESULTS = "results.parquet"
 QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 
-__all__ = ["run_sweep", "SweepOutcome", "chunk_path", "read_results", "summarize", "MANIFEST", "RESULTS"]
+__all__ = ["run_sweep", "SweepOutcome", "SweepJob", "chunk_path", "read_results", "summarize", "MANIFEST", "RESULTS"]
 
 
 @dataclass(frozen=True)
@@ -46,11 +46,13 @@ class SweepOutcome:
     complete : bool
         Every chunk has its file (False after ``max_chunks`` stopped the sweep early).
     chunks_run, chunks_skipped : int
-        Chunks computed now, chunks found on disk (``resume``).
+        Chunks computed now, chunks found on disk and verified (``resume``).
     summary : dict or None
         The summary (only when complete).
     seconds : float
         Wall time of the computation (excluding cluster start-up and warm-up).
+    chunks_redone : tuple of int
+        Chunks found on disk that failed verification and were computed again.
     """
 
     out: Path
@@ -59,57 +61,90 @@ class SweepOutcome:
     chunks_skipped: int
     summary: dict | None
     seconds: float
+    chunks_redone: tuple[int, ...] = ()
 
 
-def chunk_path(out: Path, chunk: int) -> Path:
-    """File of chunk ``chunk`` under ``out``."""
-    return Path(out) / CHUNK_DIR / f"chunk-{chunk:06d}.parquet"
+class SweepJob(ChunkJob):
+    """A sweep as a job of the chunk executor: samples in chunks of ``chunk_size``, run on Dask.
 
+    Parameters
+    ----------
+    spec : StudySpec
+        The loaded study.
+    """
 
-def _write_atomic_table(table, path: Path) -> None:
-    import pyarrow.parquet as pq
+    kind = "sweep"
+    manifest_name = MANIFEST
+    results_name = RESULTS
+    id_column = "sample"
+    unit = "sample"
+    lost_hint = " (out of memory? see --worker-memory)"
+    error = StudyError
 
-    with atomic_file(path) as fh:  # unique, exclusively created temporary name, then rename
-        pq.write_table(table, fh)
+    def __init__(self, spec: StudySpec) -> None:
+        self.spec = spec
 
+    @property
+    def label(self) -> str:
+        """The study's name."""
+        return self.spec.study.name
 
-def _write_atomic_text(text: str, path: Path) -> None:
-    atomic_write(path, text)
+    @property
+    def n_chunks(self) -> int:
+        """Chunks of the study."""
+        return self.spec.n_chunks
 
+    @property
+    def n_rows(self) -> int:
+        """Samples of the study."""
+        return self.spec.n_samples
 
-def _manifest(spec: StudySpec) -> dict:
-    from .. import __version__
-    from ..jit import source_hash
+    def chunk_ids(self, chunk: int) -> range:
+        """Sample indices of chunk ``chunk``."""
+        return self.spec.chunk_range(chunk)
 
-    return {"fingerprint": spec.fingerprint(), "name": spec.study.name, "source": spec.source,
-            "n_samples": spec.n_samples, "n_chunks": spec.n_chunks, "chunk_size": spec.study.chunk_size,
-            "study": spec.study.model_dump(mode="json"), "auvtrack_version": __version__,
-            "source_hash": source_hash()}
+    def definition(self) -> dict:
+        """The study's fingerprint (file contents and base scenario)."""
+        return {"study": self.spec.fingerprint()}
 
+    def schema(self):
+        """:func:`auvtrack.batch.sweep_worker.result_schema` of the study."""
+        from .sweep_worker import result_schema
 
-def _prepare_out(spec: StudySpec, out: Path, resume: bool) -> set[int]:
-    """Create or check the output folder; return the chunks already done."""
-    (out / CHUNK_DIR).mkdir(parents=True, exist_ok=True)
-    man_path = out / MANIFEST
-    fp = spec.fingerprint()
-    done = {c for c in range(spec.n_chunks) if chunk_path(out, c).exists()}
-    if man_path.exists():
-        try:
-            old = json.loads(man_path.read_text())
-        except (OSError, ValueError):
-            old = {}
-        if old.get("fingerprint") != fp:
-            raise StudyError(f"--out: {out} holds a different study ({old.get('source', '?')}); "
-                             "choose another folder")
-        if done and not resume:
-            raise StudyError(f"--out: {out} already holds {len(done)} of {spec.n_chunks} chunks of this study; "
-                             "pass --resume to finish it or choose another folder")
-    elif done:
-        raise StudyError(f"--out: {out} holds chunk files but no {MANIFEST}; choose another folder")
-    _write_atomic_text(json.dumps(_manifest(spec), indent=2), man_path)
-    for stale in (out / CHUNK_DIR).glob(".chunk-*.tmp"):  # left by an interrupted write
-        stale.unlink(missing_ok=True)
-    return done
+        return result_schema(self.spec)
+
+    def manifest(self) -> dict:
+        """Name, source, sizes and the study itself."""
+        spec = self.spec
+        return {"name": spec.study.name, "source": spec.source, "study_fingerprint": spec.fingerprint(),
+                "n_samples": spec.n_samples, "chunk_size": spec.study.chunk_size,
+                "study": spec.study.model_dump(mode="json")}
+
+    def describe(self, manifest: dict) -> str:
+        """The study file another sweep's manifest names."""
+        return f"study {manifest.get('name', '?')!r} from {manifest.get('source', '?')}"
+
+    def format1_fingerprint(self) -> str:
+        """The study's fingerprint, which format-1 manifests record."""
+        return self.spec.fingerprint()
+
+    def run_local(self, ids: range, workers: int | None):
+        """The samples ``ids`` run in this process (one core, as on a worker)."""
+        from .sweep_worker import run_samples
+
+        return run_samples(self.spec, list(ids))
+
+    def dask_call(self, ids: range) -> tuple:
+        """:func:`auvtrack.batch.sweep_worker.run_samples` of the study and the samples."""
+        from .sweep_worker import run_samples
+
+        return run_samples, (self.spec, list(ids)), {}
+
+    def lost_rows(self, ids: range, detail: str):
+        """:func:`auvtrack.batch.sweep_worker.lost_rows` of the samples."""
+        from .sweep_worker import lost_rows
+
+        return lost_rows(self.spec, list(ids), detail)
 
 
 DEFAULT_WORKER_MEMORY = "1GiB"
@@ -150,17 +185,26 @@ def _client(workers: int | None, scheduler: str | None, memory_limit: str | int)
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
-        return Client(scheduler), None
+        from .scheduler import SchedulerError, connect_scheduler
+
+        try:
+            return connect_scheduler(scheduler), None
+        except SchedulerError as exc:
+            raise StudyError(str(exc)) from None
     from .runner import default_workers
 
     n = default_workers() if workers is None else workers
     # a task whose worker dies is not retried on other workers (it would kill them too): its
-    # chunk is split into single samples instead (_compute)
+    # chunk is split into single samples instead (auvtrack.batch.executor)
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                                memory_limit=parse_memory(memory_limit), env={"NUMBA_NUM_THREADS": "1"},
                                silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+    client = Client(cluster)
+    from .sweep_worker import IgnoreInterruptsPlugin
+
+    client.register_plugin(IgnoreInterruptsPlugin(), name=IgnoreInterruptsPlugin.name)  # Ctrl-C is the client's
+    return client, cluster
 
 
 def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | None = None,
@@ -180,7 +224,9 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:port``); no cluster is started.
     resume : bool, optional
-        Continue a sweep in ``out``: chunks whose file exists are not run again.
+        Continue a sweep in ``out``: chunks whose file passes verification (this sweep's
+        fingerprint, this chunk, its content hash) are kept; the others are named on one line
+        and run again.
     max_chunks : int, optional
         Stop after this many chunks have been written (the rest stay to ``resume``).
     progress : bool, optional
@@ -198,135 +244,29 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
     Returns
     -------
     SweepOutcome
+        Whether the sweep is complete (then with its summary), chunks run, kept and recomputed,
+        and the time the chunks took.
 
     Raises
     ------
     StudyError
-        Invalid study file or an output folder holding another study.
+        Invalid study file, an output folder holding another study or other files, a
+        ``--scheduler`` address where no Dask scheduler answers, or a cluster that lost every worker.
     """
     spec = study if isinstance(study, StudySpec) else load_study(study)
-    if workers is not None and workers < 1:
-        raise StudyError(f"--workers: must be >= 1 (got {workers})")
-    if max_chunks is not None and max_chunks < 1:
-        raise StudyError(f"max_chunks: must be >= 1 (got {max_chunks})")
+    check_workers(workers, StudyError)
     parse_memory(memory_limit)
-    out = Path(out)
-    done = _prepare_out(spec, out, resume)
-    todo = [c for c in range(spec.n_chunks) if c not in done]
-    own = client is None
-    cluster = None
-    seconds = 0.0
-    written = 0
-    if todo:
-        if own:
-            client, cluster = _client(workers, scheduler, memory_limit)
-        try:
-            written, seconds = _compute(spec, out, todo, client, max_chunks, progress, on_chunk,
-                                        n_done=sum(len(spec.chunk_range(c)) for c in done))
-        except ClusterLost as exc:
-            kept = sum(1 for c in range(spec.n_chunks) if chunk_path(out, c).exists())
-            raise StudyError(f"{exc}; {kept} of {spec.n_chunks} chunks are kept in {out}: "
-                             "finish with --resume once the cluster has workers") from None
-        finally:
-            if own:
-                client.close()
-                if cluster is not None:
-                    cluster.close()
-    complete = all(chunk_path(out, c).exists() for c in range(spec.n_chunks))
+    cluster = None if client is not None or scheduler else (lambda: _client(workers, None, memory_limit))
+    res = execute_chunks(SweepJob(spec), out, resume=resume, client=client, scheduler=scheduler,
+                         start_cluster=cluster, max_chunks=max_chunks, progress=progress, on_chunk=on_chunk)
     summary = None
-    if complete:
-        combine(spec, out)
-        summary = summarize(out / RESULTS, spec)
-        summary["seconds"] = seconds
-        _write_atomic_text(json.dumps(summary, indent=2, default=_json_default), out / "summary.json")
-        _write_atomic_text(summary_markdown(summary), out / "summary.md")
-    return SweepOutcome(out, complete, written, len(done), summary, seconds)
-
-
-def _compute(spec: StudySpec, out: Path, todo: list[int], client, max_chunks: int | None, progress: bool,
-             on_chunk, n_done: int) -> tuple[int, float]:
-    from tqdm.auto import tqdm
-
-    from .dask_wait import completed
-    from .sweep_worker import WarmupPlugin, run_chunk
-
-    client.register_plugin(WarmupPlugin(), name=WarmupPlugin.name)
-    token = f"{spec.fingerprint()[:12]}-{uuid.uuid4().hex[:8]}"  # fresh keys: never reuse cancelled tasks
-    t0 = time.perf_counter()
-    futures = [client.submit(run_chunk, spec, c, key=f"auvtrack-sweep-{token}-{c}", retries=1) for c in todo]
-    chunk_of = {f.key: c for f, c in zip(futures, todo)}
-    written = 0
-    bar = tqdm(total=spec.n_samples, initial=n_done, unit="sample", desc=spec.study.name, disable=not progress,
-               smoothing=0.1)
-    try:
-        for fut in completed(futures, client, what="running the sweep's chunks"):
-            c = chunk_of[fut.key]
-            table = _chunk_table(spec, c, fut, client, token)
-            path = chunk_path(out, c)
-            if not path.exists():  # idempotent: a chunk is written once
-                _write_atomic_table(table, path)
-            fut.release()
-            written += 1
-            bar.update(table.num_rows)
-            if on_chunk is not None:
-                on_chunk(written, client)
-            if max_chunks is not None and written >= max_chunks:
-                break
-    finally:
-        bar.close()
-        pending = [f for f in futures if not f.done()]
-        if pending:
-            client.cancel(pending)
-    return written, time.perf_counter() - t0
-
-
-def _chunk_table(spec: StudySpec, chunk: int, fut, client, token: str, attempts: int = 2):
-    """The table of a finished chunk task; when its worker died, run its samples one at a time.
-
-    A worker that dies fails every task queued on it, so a sample is blamed only when it kills a
-    worker ``attempts`` times running on its own: it is then recorded as failed (cause
-    ``worker_died``), and one memory-hungry sample costs its own row, never the sweep.
-    """
-    from distributed import KilledWorker
-
-    from .dask_wait import result
-    from .sweep_worker import lost_rows, run_samples
-
-    try:
-        return result(fut, client, what=f"running chunk {chunk}")
-    except KilledWorker:
-        pass
-    import pyarrow as pa
-
-    tables = []
-    for i in spec.chunk_range(chunk):
-        for attempt in range(attempts):
-            single = client.submit(run_samples, spec, [i], key=f"auvtrack-sample-{token}-{i}-{attempt}", retries=0)
-            try:
-                tables.append(result(single, client, what=f"running sample {i} alone"))
-                break
-            except KilledWorker as exc:
-                reason = " ".join(str(exc).split())[:200]
-            finally:
-                single.release()
-        else:
-            tables.append(lost_rows(spec, [i], f"the worker process died running this sample alone, {attempts} times "
-                                               f"(out of memory? see --worker-memory): {reason}"))
-    return pa.concat_tables(tables)
-
-
-def combine(spec: StudySpec, out: Path) -> Path:
-    """Stream every chunk file, in chunk order, into ``out/results.parquet`` (atomic)."""
-    import pyarrow.parquet as pq
-
-    from .sweep_worker import result_schema
-
-    schema = result_schema(spec)
-    path = out / RESULTS
-    with atomic_file(path) as fh, pq.ParquetWriter(fh, schema) as writer:
-        for c in range(spec.n_chunks):
-            writer.write_table(pq.read_table(chunk_path(out, c), schema=schema))
-    return path
+    if res.complete:
+        summary = summarize(res.out / RESULTS, spec)
+        summary["seconds"] = res.seconds
+        atomic_write(res.out / "summary.json", json.dumps(summary, indent=2, default=_json_default))
+        atomic_write(res.out / "summary.md", summary_markdown(summary))
+    return SweepOutcome(res.out, res.complete, res.chunks_run, res.chunks_kept, summary, res.seconds,
+                        res.chunks_redone)
 
 
 def read_results(out: str | Path):

@@ -26,11 +26,13 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, Validat
 from ..scenario.errors import ScenarioError, format_value, one_line, translate
 from ..scenario.names import check_name
 
-__all__ = ["StudyError", "StudyFile", "StudySpec", "load_study", "PAPER_SCENARIO", "MAX_SAMPLES"]
+__all__ = ["StudyError", "StudyFile", "StudyLimits", "StudySpec", "load_study", "PAPER_SCENARIO", "MAX_SAMPLES"]
 
 PAPER_SCENARIO = "paper"
 MAX_SAMPLES = 100_000_000
 MAX_CHUNK = 1_000_000
+MAX_GRID_VALUES = 1_000_000
+MAX_CHUNK_FILES = 1_000_000
 
 Num = Annotated[float, Strict(), AllowInfNan(False)]
 Scalar = Union[Annotated[bool, Strict()], Annotated[int, Strict()], Num, Annotated[str, Strict()]]
@@ -107,6 +109,27 @@ class LogUniform(_Model):
 Distribution = Annotated[Union[Uniform, Normal, LogUniform], Field(discriminator="dist")]
 
 
+class StudyLimits(_Model):
+    """``[limits]`` of a study file: the largest plan accepted, checked before anything is set up.
+
+    Each grid value is validated with a full set-up when the study loads, and every sample is a
+    run and a row, so the defaults keep loading to seconds and a sweep to days; raise them
+    deliberately (each has a hard ceiling of its own).
+    """
+
+    max_samples: Annotated[int, Strict(), Field(ge=1, le=MAX_SAMPLES)] = Field(
+        1_000_000, description="samples: grid points x samples")
+    max_grid_values: Annotated[int, Strict(), Field(ge=1, le=MAX_GRID_VALUES)] = Field(
+        1_000, description="values of one grid key (each checked with a full set-up at load)")
+    max_chunks: Annotated[int, Strict(), Field(ge=1, le=MAX_CHUNK_FILES)] = Field(
+        100_000, description="chunks (Dask tasks, chunk files): samples / chunk_size")
+
+
+def _over_limit(field: str, what: str, key: str, limit: int, ceiling: int, hint: str = "") -> ValueError:
+    return ValueError(f"{field}: {what}, more than limits.{key} = {limit} ({hint}raise it deliberately in a "
+                      f"[limits] table of the study file, up to {ceiling})")
+
+
 class StudyFile(_Model):
     """The keys of a study file (see ``docs/sweeps.md``)."""
 
@@ -120,11 +143,30 @@ class StudyFile(_Model):
     common_seeds: Annotated[bool, Strict()] = False
     grid: dict[str, Annotated[list[Any], Field(min_length=1)]] = Field(default_factory=dict)
     random: dict[str, Distribution] = Field(default_factory=dict)
+    limits: StudyLimits = Field(default_factory=StudyLimits)
 
     @field_validator("name")
     @classmethod
     def _name(cls, v: str) -> str:
         return check_name(v)  # it becomes the folder sweeps/<name>: the rule of scenario names
+
+    @model_validator(mode="after")
+    def _plan(self) -> "StudyFile":
+        lim = self.limits
+        for key, vals in self.grid.items():
+            if len(vals) > lim.max_grid_values:
+                raise _over_limit(f"grid.{key}", f"{len(vals)} values", "max_grid_values", lim.max_grid_values,
+                                  MAX_GRID_VALUES, "each is checked with a full set-up before the sweep starts; ")
+        n = self.n_points * self.samples
+        if n > lim.max_samples:
+            field = "grid" if self.n_points > lim.max_samples else "samples"
+            raise _over_limit(field, f"{self.n_points} grid points x {self.samples} samples = {n} samples",
+                              "max_samples", lim.max_samples, MAX_SAMPLES)
+        chunks = -(-n // self.chunk_size)
+        if chunks > lim.max_chunks:
+            raise _over_limit("chunk_size", f"{n} samples in chunks of {self.chunk_size} make {chunks} chunks",
+                              "max_chunks", lim.max_chunks, MAX_CHUNK_FILES, "raise chunk_size, or ")
+        return self
 
     @model_validator(mode="after")
     def _keys(self) -> "StudyFile":
@@ -143,9 +185,6 @@ class StudyFile(_Model):
                 if key == self.seed_key:
                     raise ValueError(f"{section}: {key!r} is the seed_key, which receives each sample's seed")
                 seen.add(key)
-        n = self.n_points * self.samples
-        if n > MAX_SAMPLES:
-            raise ValueError(f"samples: grid points x samples must be <= {MAX_SAMPLES} (got {n})")
         return self
 
     @property

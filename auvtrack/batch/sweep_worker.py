@@ -17,7 +17,7 @@ FIXED_COLUMNS = ("sample", "point", "replicate")
 TAIL_COLUMNS = ("seed", "status", "cause", "detail", "fail_time")
 
 __all__ = ["run_chunk", "run_samples", "lost_rows", "result_schema", "worker_memory_budget", "WarmupPlugin",
-           "worker_warmup", "STATUS_OK", "STATUS_FAILED", "STATUS_INVALID", "CAUSE_MEMORY", "CAUSE_WORKER_DIED"]
+           "worker_warmup", "IgnoreInterruptsPlugin", "STATUS_OK", "STATUS_FAILED", "STATUS_INVALID", "CAUSE_MEMORY", "CAUSE_WORKER_DIED"]
 
 
 def _grid_type(values: list[Any]):
@@ -226,3 +226,22 @@ class WarmupPlugin(_WorkerPlugin):  # type: ignore[misc,valid-type]
         import asyncio
 
         await asyncio.get_running_loop().run_in_executor(None, worker_warmup)
+
+
+class IgnoreInterruptsPlugin(_WorkerPlugin):  # type: ignore[misc,valid-type]
+    """Dask worker plugin for the workers of a cluster the command started itself: SIGINT is ignored.
+
+    A terminal's Ctrl-C reaches every process of its process group, the local workers too; the
+    command closes them itself.  Without this, a second Ctrl-C while the cluster closes interrupts
+    each worker's event loop in its shutdown and prints asyncio ``CancelledError`` tracebacks.
+    Never registered on a cluster the user runs (``--scheduler``): its workers keep their Ctrl-C.
+    """
+
+    name = "auvtrack-ignore-interrupts"
+
+    def setup(self, worker) -> None:  # noqa: D102
+        import signal
+        import threading
+
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGINT, signal.SIG_IGN)

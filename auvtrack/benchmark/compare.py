@@ -22,7 +22,8 @@ import numpy as np
 from .._atomic import atomic_file
 from . import execute as runner
 from . import leaderboard as lb
-from .suite import DEFAULT_SUITE, CRITERIA, ControllerEntry, Suite, load_suite, resolve_controllers
+from .suite import (DEFAULT_SUITE, CRITERIA, ControllerEntry, Suite, check_competitor, load_suite,
+                    resolve_controllers)
 
 __all__ = ["compare", "CompareOutcome", "analyse", "representative_seeds", "default_out"]
 
@@ -158,7 +159,8 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
             scheduler: str | None = None, client: Any = None, workers: int | None = None,
             backend: str | None = None, resume: bool = False,
             progress: bool = True, max_chunks: int | None = None, chunk_size: int = 48,
-            entries: Sequence[ControllerEntry] | None = None) -> CompareOutcome:
+            entries: Sequence[ControllerEntry] | None = None, max_runs: int = runner.DEFAULT_MAX_RUNS,
+            notify: Any = None) -> CompareOutcome:
     """Run a benchmark comparison and write its report.
 
     Parameters
@@ -166,7 +168,8 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     suite : str, Path or Suite
         A shipped suite's name, a suite file, or a loaded suite.
     controllers : sequence of str, optional
-        Built-in kinds to compare (default: every registered tracking controller).
+        Built-in kinds to compare (None: every registered tracking controller; an empty list is
+        refused, and so is a kind that does not track a reference).
     plugins : sequence of path, optional
         Plug-in controller files; each enters under its file name.
     quick : bool, optional
@@ -190,7 +193,12 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     chunk_size : int, optional
         Runs per chunk.
     entries : sequence of ControllerEntry, optional
-        Explicit competitors (overrides ``controllers`` and ``plugins``; tests).
+        Explicit competitors (overrides ``controllers`` and ``plugins``; tests); each must track a
+        reference (:func:`~auvtrack.benchmark.suite.check_competitor`).
+    max_runs : int, optional
+        Refuse a plan of more runs (``--max-runs``), before anything is planned.
+    notify : callable, optional
+        Receives the one-line notices of the execution (chunks that failed verification).
 
     Returns
     -------
@@ -202,12 +210,18 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     s = suite if isinstance(suite, Suite) else load_suite(suite)
     if quick and not s.quick:
         s = s.quick_variant()
-    ents = list(entries) if entries is not None else resolve_controllers(
-        list(controllers) if controllers else None, list(plugins or []), s.file.gain_preset)
+    if entries is not None:
+        ents = list(entries)
+        for e in ents:
+            check_competitor(e)
+    else:
+        ents = resolve_controllers(None if controllers is None else list(controllers), list(plugins or []),
+                                   s.file.gain_preset)
     folder = Path(out) if out is not None else default_out(s)
     load0 = _load_average()
-    ex = runner.execute(s, ents, folder, resume=resume, scheduler=scheduler, client=client, workers=workers, backend=backend,
-                        chunk_size=chunk_size, max_chunks=max_chunks, progress=progress)
+    ex = runner.execute(s, ents, folder, resume=resume, scheduler=scheduler, client=client, workers=workers,
+                        backend=backend, chunk_size=chunk_size, max_chunks=max_chunks, max_runs=max_runs,
+                        progress=progress, notify=notify)
     load1 = _load_average()
     if not ex.complete:
         return CompareOutcome(folder, False, None, ex, 0.0)

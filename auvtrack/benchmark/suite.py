@@ -34,8 +34,8 @@ from ..batch.sweep_spec import Distribution
 from ..scenario.errors import ScenarioError, translate
 
 __all__ = ["SuiteError", "SuiteFile", "Suite", "Task", "Tier", "Start", "ControllerEntry", "load_suite",
-           "available_suites", "CRITERIA", "METRICS", "tracking_kinds", "resolve_controllers", "start_state",
-           "DEFAULT_SUITE"]
+           "available_suites", "CRITERIA", "METRICS", "tracking_kinds", "check_competitor", "resolve_controllers",
+           "start_state", "DEFAULT_SUITE"]
 
 DEFAULT_SUITE = "auv-track-v1"
 METRICS: tuple[str, ...] = ("rmse", "itae", "max_error", "settling", "energy", "tv")
@@ -206,16 +206,54 @@ class ControllerEntry:
 
 
 def tracking_kinds() -> list[str]:
-    """Built-in controllers that track a reference: :data:`auvtrack.control.BUILTIN_NAMES` but the open-loop kinds.
+    """Built-in controllers that track a reference: those whose registration says so (``ControllerSpec.tracks``).
 
     Returns
     -------
     list of str
-        Kinds in registration order.
+        Kinds in registration order (the open-loop kinds are left out).
     """
-    from ..control import BUILTIN_NAMES
+    from ..control import BUILTIN_NAMES, CONTROLLERS
 
-    return [k for k in BUILTIN_NAMES if not k.startswith("open_loop")]
+    return [k for k in BUILTIN_NAMES if CONTROLLERS[k].tracks]
+
+
+def check_competitor(entry: "ControllerEntry") -> None:
+    """Refuse a competitor that cannot enter a tracking comparison: open loop, or a plug-in that does not import.
+
+    Parameters
+    ----------
+    entry : ControllerEntry
+        A built-in kind or a plug-in file (``controller.kind = "plugin"``).
+
+    Raises
+    ------
+    SuiteError
+        One line naming ``--controllers`` or ``--plugin``: an unknown kind, a controller whose
+        ``TRACKS`` is False, or a plug-in file that cannot be imported or breaks the contract.
+    """
+    from ..control import CONTROLLERS
+
+    kind = entry.table.get("kind")
+    if kind == "plugin":
+        from ..control.plugin import load
+
+        module = str(entry.table.get("module", ""))
+        try:
+            _, spec = load(module)
+        except ValueError as exc:
+            why = " ".join(str(exc).split())
+            raise SuiteError(f"--plugin: {why}" if module in why else f"--plugin: {module}: {why}") from None
+        if not spec.tracks:
+            raise SuiteError(f"--plugin: {module}: does not track a reference (TRACKS = False); "
+                             "a comparison is of tracking controllers")
+        return
+    if kind not in CONTROLLERS:
+        raise SuiteError(f"--controllers: unknown controller {kind!r} (allowed: {', '.join(tracking_kinds())}; "
+                         "plug-in files with --plugin)")
+    if not CONTROLLERS[kind].tracks:
+        raise SuiteError(f"--controllers: {kind!r} does not track a reference (allowed: "
+                         f"{', '.join(tracking_kinds())}; plug-in files with --plugin)")
 
 
 def _builtin_entry(kind: str, pattern: str) -> ControllerEntry:
@@ -237,8 +275,10 @@ def _plugin_entry(path: str | Path, taken: set[str]) -> ControllerEntry:
     while label in taken:
         label, k = f"{base}-{k}", k + 1
     digest = hashlib.sha256(p.read_bytes()).hexdigest()
-    return ControllerEntry(label, {"kind": "plugin", "module": str(p)}, f"plug-in {p.name}: its Params defaults",
-                           digest)
+    entry = ControllerEntry(label, {"kind": "plugin", "module": str(p)}, f"plug-in {p.name}: its Params defaults",
+                            digest)
+    check_competitor(entry)  # it imports and follows the contract, now rather than in every run's set-up
+    return entry
 
 
 def resolve_controllers(names: list[str] | None = None, plugins: list[str | Path] | None = None,
@@ -248,7 +288,7 @@ def resolve_controllers(names: list[str] | None = None, plugins: list[str | Path
     Parameters
     ----------
     names : list of str, optional
-        Built-in kinds; default :func:`tracking_kinds`.
+        Built-in kinds that track a reference; None: :func:`tracking_kinds` (an empty list is refused).
     plugins : list of path, optional
         Plug-in controller files (``controller.kind = "plugin"``), each entering under its file name.
     gain_preset : str, optional
@@ -262,16 +302,16 @@ def resolve_controllers(names: list[str] | None = None, plugins: list[str | Path
     Raises
     ------
     SuiteError
-        An unknown or repeated kind, a missing plug-in file, or no controller at all.
+        An unknown, open-loop or repeated kind, an empty list of kinds, a plug-in file that is
+        missing, does not import or does not track, or no controller at all.
     """
-    from ..control import BUILTIN_NAMES
-
-    kinds = tracking_kinds() if not names else list(names)
+    if names is not None and not list(names):
+        raise SuiteError("--controllers: names no controller (omit it to compare every tracking controller: "
+                         f"{', '.join(tracking_kinds())})")
+    kinds = tracking_kinds() if names is None else list(names)
     entries: list[ControllerEntry] = []
     for k in kinds:
-        if k not in BUILTIN_NAMES:
-            raise SuiteError(f"--controllers: unknown controller {k!r} (allowed: {', '.join(tracking_kinds())}; "
-                             "plug-in files with --plugin)")
+        check_competitor(ControllerEntry(str(k), {"kind": k}, ""))
         if any(e.label == k for e in entries):
             raise SuiteError(f"--controllers: {k!r} is given twice")
         entries.append(_builtin_entry(k, gain_preset))

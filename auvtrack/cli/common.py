@@ -8,7 +8,6 @@ import click
 EXIT_BAD_INPUT = 2
 EXIT_SIM_FAILED = 3
 EXIT_INTERRUPTED = 130
-MAX_WORKERS = 256
 MAX_REPEAT = 1000
 LONG_RUN_STEPS = 1_000_000  # runs this long announce themselves (and that Ctrl-C keeps their result)
 

@@ -27,6 +27,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..batch.runner import default_workers
 from ..control.fxtntsmc.theory import fixed_time_bounds
 from ..vehicle.kinematics import attitude, j3_inv, virtual_point
 from ..reference import build_reference
@@ -395,7 +396,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     jobs = [(s0, k, d, float(m), st) for s0 in st.starts for k in st.controllers for d in st.directions
             for m in st.magnitudes]
     compile_first([(k, "5dof") for k in kinds_in(o for v in st.controllers for o in VARIANTS[v])], progress=progress)
-    with ThreadPoolExecutor(max_workers=2) as pool:  # the compiled kernel releases the GIL
+    with ThreadPoolExecutor(max_workers=default_workers()) as pool:  # the compiled kernel releases the GIL
         rows = list(tqdm(pool.map(_run_one, jobs), total=len(jobs), disable=not progress, desc="fixed-time"))
     sc = load_scenario(paper_scenario_path(), [f"sim.duration={st.duration:g}"])
     b = fixed_time_bounds(sc.controller, horizon=st.duration)

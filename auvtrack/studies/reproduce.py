@@ -23,6 +23,7 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from ..batch.runner import default_workers
 from ..control.fxtntsmc import StartOutsideEnvelope
 from ..control.gain_presets import get_gain_preset
 from ..simulation import plotting
@@ -130,7 +131,7 @@ def _run(kind: str, overrides: list[str], window: tuple[float, float]) -> tuple[
     base = [f"controller.kind={kind}", *overrides]
     preps = [prepare(load_scenario(paper_scenario_path(), base)),
              prepare(load_scenario(paper_scenario_path(), base + [f"metrics.window=[{window[0]}, {window[1]}]"]))]
-    with ThreadPoolExecutor(max_workers=2) as pool:
+    with ThreadPoolExecutor(max_workers=default_workers()) as pool:
         full, steady = pool.map(run_prepared, preps)
     return full, steady
 
@@ -293,7 +294,7 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     pairs = list(runs.items())
     kw = {"fig6_inputs": {"steady_from": window[0]}}
     jobs = [(name, pairs, out / "figures", kw.get(name, {})) for name, _ in FIGURES]
-    with ProcessPoolExecutor(max_workers=2) as pool:  # figures are independent: use both cores
+    with ProcessPoolExecutor(max_workers=default_workers()) as pool:  # figures are independent: one per core
         for name in pool.map(_render, jobs):
             bar.set_postfix_str(name)
             bar.update()

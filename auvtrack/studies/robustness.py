@@ -102,8 +102,8 @@ class RobustnessConfig:
         Run length and RK4 step (s).
     vehicles : tuple of str
         Vehicle presets.
-    workers : int
-        Threads.
+    workers : int or None
+        Threads (None: the batch runner's :func:`~auvtrack.batch.runner.default_workers`).
     """
 
     n: int = 100
@@ -111,7 +111,7 @@ class RobustnessConfig:
     duration: float = 40.0
     dt: float = 0.001
     vehicles: tuple[str, ...] = ("paper", "remus100")
-    workers: int = 2
+    workers: int | None = None
 
 
 FULL = RobustnessConfig()

@@ -363,8 +363,15 @@ def _rounded(gains: dict[str, float], digits: int = 4) -> dict[str, float]:
     return {k: float(f"{v:.{digits}g}") for k, v in gains.items()}
 
 
+def _threads(workers: int | None) -> int:
+    """Threads of a pool: ``workers``, or the batch runner's :func:`~auvtrack.batch.runner.default_workers`."""
+    from ..batch.runner import default_workers
+
+    return default_workers() if workers is None else max(1, workers)
+
+
 def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *,
-         cases: Sequence[Case] | None = None, workers: int = 2,
+         cases: Sequence[Case] | None = None, workers: int | None = None,
          progress: Callable[[str], None] | None = None) -> TuneResult:
     """Tune the gains of ``kind`` with seeded differential evolution.
 
@@ -379,8 +386,8 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     cases : sequence of Case, optional
         Training scenarios (default: the first ``budget.n_train`` of :data:`TRAIN_CASES`).
     workers : int, optional
-        Threads evaluating a generation (the compiled kernel releases the GIL); the result
-        does not depend on it.
+        Threads evaluating a generation (the compiled kernel releases the GIL; default
+        :func:`auvtrack.batch.runner.default_workers`); the result does not depend on it.
     progress : callable, optional
         Called with a one-line status after each generation.
 
@@ -410,7 +417,7 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     start = space.defaults()
     history: list[float] = []
     wall = time.perf_counter()
-    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+    with ThreadPoolExecutor(max_workers=_threads(workers)) as pool:
         def callback(intermediate_result):  # SciPy >= 1.12: an OptimizeResult with x and fun
             history.append(float(intermediate_result.fun))
             if progress:
@@ -429,7 +436,7 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
 
 
 def evaluate(kind: str, gains: dict[str, float], cases: Sequence[Case], duration: float, dt: float,
-             objective: Objective = Objective(), workers: int = 2) -> list[dict]:
+             objective: Objective = Objective(), workers: int | None = None) -> list[dict]:
     """J and metrics of ``gains`` on each of ``cases`` (runs in ``workers`` threads).
 
     Parameters
@@ -445,14 +452,14 @@ def evaluate(kind: str, gains: dict[str, float], cases: Sequence[Case], duration
     objective : Objective, optional
         Weights of J.
     workers : int, optional
-        Threads.
+        Threads (default :func:`auvtrack.batch.runner.default_workers`).
 
     Returns
     -------
     list of dict
         One record per case (see :func:`run_cost`) with its ``case`` name.
     """
-    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+    with ThreadPoolExecutor(max_workers=_threads(workers)) as pool:
         out = list(pool.map(lambda c: run_cost(c, kind, gains, duration, dt, objective)[1], cases))
     for c, rec in zip(cases, out):
         rec["case"] = c.name

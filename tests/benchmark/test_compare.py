@@ -14,33 +14,7 @@ from auvtrack.benchmark import execute as runner
 from auvtrack.benchmark.compare import compare
 from auvtrack.benchmark.suite import (ControllerEntry, SuiteError, load_suite, resolve_controllers, tracking_kinds)
 from report_check import check_html_report
-
-TINY = """
-name = "tiny"
-version = 1
-seed = 5
-seeds = 3
-bootstrap_resamples = 200
-[base]
-"vehicle.preset" = "remus100"
-"sim.dt" = 0.002
-"disturbance" = []
-[quick]
-seeds = 2
-duration = 1.0
-[tasks.helix]
-duration = 3.0
-reference = { kind = "helix", radius = 10.0, omega = 0.1, climb = -0.25, center = [0.0, 0.0, 20.0] }
-[tasks.line]
-duration = 2.0
-reference = { kind = "line", start = [0.0, 0.0, 5.0], velocity = [1.0, 0.0, 0.0] }
-[tiers.calm]
-start = { lateral = 0.3 }
-[tiers.model]
-start = { lateral = 1.0, heading = 0.2 }
-[tiers.model.random]
-"uncertainty.M" = { dist = "uniform", low = -0.2, high = 0.2 }
-"""
+from tiny_suite import TINY
 
 
 @pytest.fixture(scope="module")
@@ -224,8 +198,9 @@ def test_interrupted_comparison_resumes_to_identical_numbers(tiny, tmp_path):
 
 
 def test_a_failing_controller_is_ranked_not_dropped(tiny, tmp_path):
+    # poles near -1e4 rad/s: RK4 at dt = 2 ms is unstable (|lambda dt| = 20 > 2.8), every run diverges
     entries = resolve_controllers(["ftsmc"]) + [
-        ControllerEntry("crash", {"kind": "open_loop", "tau0": [0.0, 300.0, 0.0]}, "open loop: 300 N m pitch")]
+        ControllerEntry("crash", {"kind": "pid", "kp": 1e8, "kd": 1e4, "ki": 0.0}, "PID far beyond RK4's stability")]
     res = compare(tiny, out=tmp_path / "f", progress=False, entries=entries)
     doc = json.loads((tmp_path / "f" / "results.json").read_text())
     board = [r["controller"] for r in doc["leaderboard"]]
@@ -264,7 +239,8 @@ def test_plan_is_every_controller_task_tier_and_seed(tiny):
     (["--suite", "nope"], "--suite: unknown suite 'nope'"),
     (["--controllers", "pid2"], "--controllers: unknown controller 'pid2'"),
     (["--plugin", "missing.py"], "--plugin: must be an existing .py file"),
-    (["--workers", "0"], "--workers: must be >= 1"),
+    (["--workers", "0"], "--workers: must be an integer in [1, 256] (got 0)"),
+    (["--workers", "100000"], "--workers: must be an integer in [1, 256] (got 100000)"),
     (["--backend", "nope"], "--backend: must be one of threads"),
 ])
 def test_bad_options_exit_2_with_one_line(args, expect, tmp_path, capsys):
@@ -301,6 +277,7 @@ def test_shipped_suite_is_sized_for_its_failure_interval():
 
 def test_ctrl_c_keeps_the_finished_chunks_and_resume_finishes(tiny, tmp_path):
     import os
+    import shlex
     import signal
     import subprocess
     import sys
@@ -322,8 +299,11 @@ def test_ctrl_c_keeps_the_finished_chunks_and_resume_finishes(tiny, tmp_path):
     assert "--resume" in err and "Traceback" not in err
     kept = sorted((out / "chunks").glob("chunk-*.parquet"))
     assert 1 <= len(kept) < 10 and not (out / "runs.parquet").exists()
-    res = compare(path, out=out, progress=False, resume=True)
-    assert res.complete and res.execution.chunks_skipped == len(kept)
+    command = err.strip().splitlines()[-1].split("the finished chunks are kept: ", 1)[1]
+    argv = shlex.split(command)  # the printed command, run verbatim
+    assert argv[:2] == ["auvtrack", "compare"] and argv[-1] == "--resume"
+    assert main(argv[1:]) == 0
+    assert json.loads((out / "results.json").read_text())["timing"]["chunks_resumed"] == len(kept)
     runs = pd.read_parquet(out / "runs.parquet")
     assert sorted(runs["run"]) == list(range(len(resolve_controllers()) * 2 * 2 * 60))
 

@@ -67,6 +67,17 @@ API = [
     "auvtrack.feasibility.steady.tightest_turn",
     "auvtrack.feasibility.demands.reference_demands",
     "auvtrack.feasibility.demands.current_bound",
+    "auvtrack.benchmark.execute.run_planned",
+    "auvtrack.benchmark.execute.plan_runs",
+    "auvtrack.benchmark.execute.check_plan",
+    "auvtrack.batch.executor.execute_chunks",
+    "auvtrack.batch.executor.check_workers",
+    "auvtrack.batch.chunk_files.check_chunk",
+    "auvtrack.batch.chunk_files.table_digest",
+    "auvtrack.batch.chunk_files.write_chunk",
+    "auvtrack.batch.scheduler.connect_scheduler",
+    "auvtrack.batch.scheduler.probe_scheduler",
+    "auvtrack.batch.sweep.run_sweep",
 ]
 
 

@@ -1,0 +1,49 @@
+"""Ctrl-C and SIGTERM for long commands (``sweep``, ``compare``): stop once, then let the clean-up finish.
+
+The first SIGINT or SIGTERM raises ``KeyboardInterrupt`` in the main thread, so the command
+stops its work, closes its Dask cluster or its batch and keeps what it finished.  Later signals
+are ignored until the process exits: a second Ctrl-C while a cluster closes would otherwise
+interrupt the shutdown and print a traceback instead of the one-line message.  (The workers of
+a cluster the command starts ignore SIGINT themselves:
+:class:`auvtrack.batch.sweep_worker.IgnoreInterruptsPlugin`.)
+"""
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from typing import Iterator
+
+__all__ = ["stop_once"]
+
+
+@contextlib.contextmanager
+def stop_once() -> Iterator[None]:
+    """Turn the first SIGINT or SIGTERM into ``KeyboardInterrupt`` and ignore the ones after it.
+
+    Outside the main thread (where Python delivers signals) nothing is changed.
+
+    Yields
+    ------
+    None
+        The previous handlers are restored on exit, unless a signal stopped the command: the
+        process is then ending (its clean-up at exit closes Dask's loops too), and both
+        signals stay ignored until it exits.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    stopping = []
+
+    def _stop(signum, frame):
+        if stopping:  # already stopping: let the clean-up finish
+            return
+        stopping.append(signum)
+        raise KeyboardInterrupt
+
+    previous = {sig: signal.signal(sig, _stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():  # once stopping, the process is ending: stay deaf until it exits
+            signal.signal(sig, signal.SIG_IGN if stopping else handler)
