@@ -461,20 +461,27 @@ def run(pb, cb, env, ref_p, settings, out):
     return CAUSE_NONE, row, n_steps * dt
 
 
+@kernel_part("njit(nogil=True)")
+def run_row(ins, i, ncols, outs):
+    """:func:`run` of row ``i`` of ``ins`` (:class:`Stacked`) into row ``i`` of ``outs`` (:class:`StackedOutputs`)."""
+    log = np.empty((0, ncols))
+    cause, _, t_stop = run(PlantBundle(ins.pp[i], ins.xp0[i]), ControllerBundle(ins.cp[i], ins.xc0[i], ins.vp[i]),
+                           EnvironmentBundle(ins.rows[i], ins.current[i], ins.noise[i]), ins.path[i],
+                           Settings(ins.si[i], ins.sf[i]), Outputs(log, outs.acc[i], outs.fail_state[i], outs.info[i]))
+    outs.cause[i] = cause
+    outs.t_stop[i] = t_stop
+
+
 @kernel_part("njit(nogil=True, parallel=True)")
 def run_many(ins, ncols, outs):
     """:func:`run` of ``len(ins.pp)`` runs of identical array shapes in a ``prange`` loop, metrics only.
 
-    ``ins`` is a :class:`Stacked`, ``outs`` a :class:`StackedOutputs` (its ``log`` unused).
+    ``ins`` is a :class:`Stacked`, ``outs`` a :class:`StackedOutputs` (its ``log`` unused).  The loop
+    body is one call: built inline, the bundles of a run lose its settings under Numba 0.68's
+    parallel lowering (every run integrated with ``dt = 0``; ``tests/batch/test_batch.py`` catches it).
     """
     for i in prange(ins.pp.shape[0]):
-        log = np.empty((0, ncols))
-        cause, _, t_stop = run(PlantBundle(ins.pp[i], ins.xp0[i]), ControllerBundle(ins.cp[i], ins.xc0[i], ins.vp[i]),
-                               EnvironmentBundle(ins.rows[i], ins.current[i], ins.noise[i]), ins.path[i],
-                               Settings(ins.si[i], ins.sf[i]), Outputs(log, outs.acc[i], outs.fail_state[i],
-                                                                       outs.info[i]))
-        outs.cause[i] = cause
-        outs.t_stop[i] = t_stop
+        run_row(ins, i, ncols, outs)
 
 
 @kernel_part("njit(nogil=True)", lanes=True)

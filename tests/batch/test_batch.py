@@ -105,7 +105,7 @@ def test_bad_arguments():
 
 def test_stage_reuse_of_reference_and_disturbance_is_exact(preps):
     """The engine reuses stage 2's reference and omega at stage 3 (same time): same numbers as fresh."""
-    from auvtrack.control.contract import WORK_SIZE
+    from auvtrack.control.contract import WORK_SIZE, LawOutputs
     from auvtrack.environment.layout import KIND_CURRENT
     from auvtrack.plant.contract import SCRATCH_SIZE
     from auvtrack.vehicle.kinematics import attitude
@@ -123,9 +123,10 @@ def test_stage_reuse_of_reference_and_disturbance_is_exact(preps):
 
     def call(xp, fresh, sk):
         refm, scr = sk
-        dxp, dxc, tau, aux, cmd = np.zeros(nxp), np.zeros(nxc), np.zeros(3), np.zeros(3), np.zeros(3)
-        st, _ = stage(t, xp, p.controller.x0, attitude(xp[3], xp[4]), 0, p.cp, p.vp_nom, p.pp, p.ref_p, rows0,
-                      p.environment.current, refm, np.zeros(WORK_SIZE), scr, cmd, dxp, dxc, tau, aux, fresh)
+        dxp, dxc, tau, aux = np.zeros(nxp), np.zeros(nxc), np.zeros(3), np.zeros(3)
+        lp = engine.Loop(p.pp, p.cp, p.vp_nom, p.ref_p, rows0, p.environment.current, 0, 0.0)
+        buf = engine.Buffers(refm, np.zeros(WORK_SIZE), scr, np.zeros(3))
+        st, _ = stage(t, xp, p.controller.x0, attitude(xp[3], xp[4]), lp, buf, dxp, LawOutputs(tau, dxc, aux), fresh)
         assert st == 0
         return dxp, tau
 
