@@ -27,7 +27,7 @@ __all__ = ["MAX_FILE_BYTES", "MAX_NESTING", "read_bounded", "check_text_nesting"
            "plain_data", "override_value"]
 
 MAX_FILE_BYTES = 16 * 2 ** 20
-"""Largest file read as TOML, bytes (a 100 000-point waypoint list takes about 4 MiB)."""
+"""Largest file read as TOML, bytes (the longest waypoint list, in full precision, fits)."""
 MAX_NESTING = 32
 """Most levels of nested tables and arrays, and most parts of one dotted key."""
 
