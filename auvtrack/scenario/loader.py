@@ -116,8 +116,7 @@ def _read_source(source: Source) -> tuple[str, dict[str, Any]]:
         except ScenarioError as exc:
             stem = Path(path).stem
             if str(exc).endswith(": file not found") and stem in available_scenarios():
-                raise ScenarioError(f"{exc} (the packaged scenario of that name is {stem!r}, without "
-                                    f"'{Path(path).suffix}' or a folder)") from None
+                raise ScenarioError(f"{exc} (a packaged scenario has that name: give the string {stem!r})") from None
             raise
         return os.fspath(source), anchor_module(data, Path(path).parent)
     raise ScenarioError(f"scenario source must be a packaged scenario's name, a TOML file path, a dict or a "
