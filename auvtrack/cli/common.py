@@ -23,6 +23,7 @@ class BadInput(click.ClickException):
 
 
 def load_arg(scenario: str, overrides: tuple[str, ...]):
+    """The validated scenario of a command's SCENARIO argument (a file or a packaged name) and its --set."""
     from ..scenario import load_scenario
 
     return load_scenario(scenario, list(overrides))
@@ -39,10 +40,12 @@ def prepare_arg(scenario: str, sc):
 
 
 def mib(n: int) -> str:
+    """``n`` bytes in MiB, three significant digits."""
     return f"{n / 2 ** 20:.3g} MiB"
 
 
 def one_line(exc: BaseException) -> str:
+    """The message of ``exc`` on one line (its type name when it has none)."""
     return " ".join(str(exc).split()) or type(exc).__name__
 
 
