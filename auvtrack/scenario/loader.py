@@ -90,6 +90,8 @@ def parse_toml_text(text: str, label: str) -> dict[str, Any]:
         raise ScenarioError(f"{label}: TOML syntax error: {one_line(str(exc))}") from None
     except RecursionError:  # the scan above bounds the nesting; this guards the parser itself
         raise ScenarioError(f"{label}: nested too deeply to parse") from None
+    except ValueError as exc:  # a value Python refuses, e.g. an integer over sys.get_int_max_str_digits()
+        raise ScenarioError(f"{label}: TOML value error: {one_line(str(exc))}") from None
     check_nesting(doc, label)
     return doc
 
@@ -118,7 +120,10 @@ def _read_source(source: Source) -> tuple[str, dict[str, Any]]:
             if str(exc).endswith(": file not found") and stem in available_scenarios():
                 raise ScenarioError(f"{exc} (a packaged scenario has that name: give the string {stem!r})") from None
             raise
-        return os.fspath(source), anchor_module(data, Path(path).parent)
+        try:
+            return os.fspath(source), anchor_module(data, Path(path).parent)
+        except ValueError as exc:  # a plug-in path that cannot be resolved
+            raise ScenarioError(f"{os.fspath(source)}: {exc}") from None
     raise ScenarioError(f"scenario source must be a packaged scenario's name, a TOML file path, a dict or a "
                         f"Scenario (got {type(source).__name__})")
 
@@ -161,7 +166,8 @@ def _hint(overrides: Sequence[Override]):
         for ov in reversed(overrides):
             d = ov.dotted
             if not path or d == path or path.startswith(d + ".") or d.startswith(path + "."):
-                return f" (set by override {ov.text!r})"
+                shown = ov.text if len(ov.text) <= 60 else ov.text[:57] + "..."
+                return f" (set by override {shown!r})"
         return ""
     return hint
 

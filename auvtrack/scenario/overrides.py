@@ -91,6 +91,8 @@ def parse_value(text: str) -> Any:
         if _BARE_WORD.match(text):
             return text
         raise ValueError(f"not a TOML value ({exc})") from None
+    except ValueError as exc:  # e.g. an integer over sys.get_int_max_str_digits()
+        raise ValueError(f"not a value Python can hold ({' '.join(str(exc).split())})") from None
     if set(doc) != {"v"}:
         raise ValueError("not a single TOML value")
     check_nesting(doc["v"], "value")

@@ -412,7 +412,12 @@ def _hostile(tmp: Path) -> list[tuple[str, list[str]]]:
     big = tmp / "big.toml"
     with open(big, "wb") as fh:
         fh.truncate(MAX_FILE_BYTES + 1)
-    cases = [(str(deep), []), (str(dotted), []), (str(big), []), (str(tmp), []),
+    bigint = tmp / "bigint.toml"
+    bigint.write_text("seed = " + "9" * (sys.get_int_max_str_digits() + 1) + "\n")
+    module = tmp / "module.toml"
+    module.write_text(f'[controller]\nkind = "plugin"\nmodule = "{"a" * 5000}.py"\n')
+    cases = [(str(deep), []), (str(dotted), []), (str(big), []), (str(tmp), []), (str(bigint), []), (str(module), []),
+             (str(PAPER), ["--set", "seed=" + "9" * (sys.get_int_max_str_digits() + 1)]),
              (str(PAPER), ["--set", "initial.eta=" + "[" * 3000 + "]" * 3000]),
              (str(PAPER), ["--set", ".".join(["sim"] * 3000) + "=1"]),
              (str(PAPER), ["--set", "plant.model=6dof", "--set", "vehicle.preset=remus100",
@@ -461,3 +466,29 @@ def test_the_longest_waypoint_list_fits_the_file_bound(tmp_path):
     path.write_text(dumps(doc))
     assert path.stat().st_size <= MAX_FILE_BYTES
     assert len(read_toml(path)["reference"]["points"]) == _MAX_POINTS
+
+
+def test_values_python_cannot_hold_are_one_line(tmp_path):
+    """An integer literal over Python's digit limit, in a file and in an override."""
+    digits = "9" * (sys.get_int_max_str_digits() + 1)
+    path = tmp_path / "s.toml"
+    path.write_text(f"seed = {digits}\n")
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    assert one_line(info.value).startswith(f"{path}: TOML value error: ")
+    with pytest.raises(ScenarioError) as info:
+        load_scenario({}, [f"seed={digits}"])
+    assert "is not a value Python can hold" in one_line(info.value) and len(str(info.value)) < 600
+
+
+def test_long_values_are_shortened_in_messages(tmp_path):
+    long = "a" * 5000
+    with pytest.raises(ScenarioError) as info:
+        load_scenario({}, [f"name={long}"])
+    assert len(one_line(info.value)) < 400 and "(set by override 'name=aaa" in str(info.value)
+    path = tmp_path / "s.toml"
+    path.write_text(f'[controller]\nkind = "plugin"\nmodule = "{long}.py"\n')
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    assert one_line(info.value).startswith(f"{path}: controller.module: the path 'aaa")
+    assert "cannot be resolved" in str(info.value) and len(str(info.value)) < 400
