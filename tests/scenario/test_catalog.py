@@ -132,3 +132,17 @@ def test_top_level_help_points_to_no_file_of_the_clone(capsys):
 def test_the_name_rule_is_the_documented_one():
     doc = (ROOT / "docs" / "scenarios.md").read_text()
     assert "letters, digits, `_` and `-` only" in doc and NAME_PATTERN.pattern == r"[A-Za-z0-9_][A-Za-z0-9_-]*"
+
+
+def test_a_sweep_study_takes_a_packaged_name(tmp_path):
+    """``scenario = "<name>"`` in a study file is the packaged scenario, as everywhere else."""
+    from auvtrack.batch.sweep_spec import StudyError, load_study
+
+    study = tmp_path / "s.toml"
+    study.write_text('scenario = "lawnmower"\nset = ["sim.duration=10"]\n')
+    spec = load_study(study)
+    assert load_scenario(spec.base) == load_scenario("lawnmower", ["sim.duration=10"])
+    study.write_text('scenario = "lawnmowr"\n')
+    with pytest.raises(StudyError, match=r"scenario: must be a packaged scenario's name or a readable scenario "
+                                         r"TOML file \(lawnmowr: unknown packaged scenario"):
+        load_study(study)
