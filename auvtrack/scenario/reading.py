@@ -57,9 +57,10 @@ def _kind(mode: int) -> str:
 def read_bounded(path: str | os.PathLike, label: str | None = None, limit: int = MAX_FILE_BYTES) -> bytes:
     """The bytes of a regular file of at most ``limit`` bytes; anything else is one line.
 
-    The file is opened without blocking and its type checked on the open descriptor, so a FIFO
-    or a device is refused without reading it, and a file swapped in after a check cannot slip
-    through.  At most ``limit + 1`` bytes are read, even from a file that grows meanwhile.
+    The file type is checked before the file is opened (a device or FIFO is never opened), and
+    again on the descriptor, opened without blocking, so that a file swapped in after the first
+    check cannot slip through.  At most ``limit + 1`` bytes are read, even from a file that grows
+    meanwhile.
 
     Parameters
     ----------
@@ -86,7 +87,12 @@ def read_bounded(path: str | os.PathLike, label: str | None = None, limit: int =
         raise ScenarioError(f"{label!r}: not a file path (it holds a NUL character)")
     flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_BINARY", 0)
     try:
-        fd = os.open(path, flags)
+        mode = os.stat(path).st_mode  # a device is never opened (opening some has effects)
+        if not stat.S_ISREG(mode):
+            raise ScenarioError(f"{label}: is {_kind(mode)}, not a TOML file (a regular file is needed)")
+        fd = os.open(path, flags)  # then checked again on the descriptor: the file may have been swapped
+    except ScenarioError:
+        raise
     except FileNotFoundError:
         raise ScenarioError(f"{label}: file not found") from None
     except IsADirectoryError:

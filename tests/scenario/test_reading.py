@@ -66,11 +66,38 @@ def test_a_fifo_is_refused_without_blocking(tmp_path):
     assert box["msg"] == f"{fifo}: is a FIFO (named pipe), not a TOML file (a regular file is needed)"
 
 
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
+def test_a_fifo_swapped_in_after_the_type_check_is_refused_without_blocking(tmp_path, monkeypatch):
+    """The second check, on the descriptor opened non-blocking: the path's type as first seen is a
+    regular file (a stand-in for a file replaced by a FIFO in between), the descriptor's a FIFO."""
+    fifo = tmp_path / "s.toml"
+    os.mkfifo(fifo)
+    regular = os.stat(__file__)
+    real_stat = os.stat
+    monkeypatch.setattr(reading.os, "stat", lambda p, *a, **k: regular if str(p) == str(fifo) else real_stat(p, *a, **k))
+    box: dict = {}
+
+    def target():
+        try:
+            read_toml(fifo)
+        except ScenarioError as exc:
+            box["msg"] = one_line(exc)
+
+    th = threading.Thread(target=target, daemon=True)
+    th.start()
+    th.join(60)
+    if th.is_alive():
+        with open(fifo, "wb"):
+            pass
+        pytest.fail("opening a FIFO blocked")
+    assert box["msg"] == f"{fifo}: is a FIFO (named pipe), not a TOML file (a regular file is needed)"
+
+
 @pytest.mark.parametrize("device", ["/dev/zero", "/dev/null", "/dev/urandom"])
 def test_a_device_is_refused_unread(device, monkeypatch):
     if not os.path.exists(device):
         pytest.skip(f"no {device}")
-    monkeypatch.setattr(reading.os, "read", lambda *a: pytest.fail("a device was read"))
+    monkeypatch.setattr(reading.os, "open", lambda *a: pytest.fail("a device was opened"))
     with pytest.raises(ScenarioError) as info:
         read_toml(device)
     assert one_line(info.value) == f"{device}: is a character device, not a TOML file (a regular file is needed)"
