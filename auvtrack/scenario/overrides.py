@@ -83,7 +83,6 @@ def parse_value(text: str) -> Any:
         raise ValueError(f"longer than the {MAX_FILE_BYTES} characters a value may have")
     try:
         check_text_nesting(f"v = {text}", "value")
-        check_text_nesting(text, "value")  # a dotted key written as the value itself
         doc = tomllib.loads(f"v = {text}")
     except ScenarioError as exc:
         raise ValueError(str(exc).removeprefix("value: ")) from None
@@ -139,8 +138,7 @@ def parse_overrides(overrides: Sequence[str] | Mapping[str, Any] | str | None) -
                 raise ScenarioError(f"override {format_value(key)}: the key must be a non-empty dotted string")
             path = _parse_path(key, key)
             plain = override_value(value, key.strip())
-            text = f"{key}={format_value(plain)}"
-            out.append(Override(text, _parse_path(key, text), plain))
+            out.append(Override(f"{key}={format_value(plain)}", path, plain))
         return out
     if not isinstance(overrides, (list, tuple)):
         raise ScenarioError(f"overrides: must be a list of 'dotted.key=value' strings, one such string or a dict "
