@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from auvtrack.scenario import ScenarioError, load_scenario, read_toml
@@ -225,6 +225,9 @@ def _toml_value(depth: int, draw_kind) -> tuple[str, object]:
 
 
 @given(kinds=st.lists(st.booleans(), min_size=0, max_size=2 * MAX_NESTING))
+@example(kinds=[True] * (MAX_NESTING - 1))
+@example(kinds=[False] * MAX_NESTING)
+@example(kinds=[True, False] * (MAX_NESTING // 2) + [True])
 @settings(max_examples=120, deadline=None)
 def test_the_nesting_bound_is_exact(kinds):
     """Up to MAX_NESTING levels in the value (one more with the document's own table) parse to the
@@ -260,6 +263,9 @@ def test_brackets_and_dots_in_strings_and_comments_do_not_count(noise):
 
 @given(parts=st.lists(st.from_regex(r"\A[a-z0-9_\-]{1,4}\Z") | st.from_regex(r'\A"[a-z.\[\]]{0,4}"\Z'),
                       min_size=1, max_size=2 * MAX_NESTING))
+@example(parts=["a"] * MAX_NESTING)
+@example(parts=["a"] * (MAX_NESTING + 1))
+@example(parts=['"x.y"'] * MAX_NESTING)
 @settings(max_examples=120, deadline=None)
 def test_the_dotted_key_bound_is_exact(parts):
     doc = f"{'.'.join(parts)} = 1\n"
