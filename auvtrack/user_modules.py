@@ -42,8 +42,12 @@ def load_module(spec: str):
     """
     if not spec.endswith(".py"):
         return importlib.import_module(spec)
-    path = Path(spec).resolve()
-    if not path.is_file():
+    try:
+        path = Path(spec).resolve()
+        found = path.is_file()
+    except (OSError, ValueError) as exc:
+        raise ImportError(f"{spec[:60]}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    if not found:
         raise ImportError(f"{path}: no such file")
     name = f"auvtrack_plugin_{identifier(path.stem)}_{file_digest(path)}"
     if name in sys.modules:
@@ -75,13 +79,24 @@ def resolve(module: str, base_dir: str | Path | None = None) -> str:
     -------
     str
         The absolute path (``.py``) or ``module`` itself.
+
+    Raises
+    ------
+    ValueError
+        A path the system cannot resolve (too long, a NUL character), one line naming it.
     """
     if not module.endswith(".py"):
         return module
-    path = Path(module).expanduser()
-    if not path.is_absolute():
-        path = Path(base_dir or Path.cwd()) / path
-    return str(path.resolve())
+    try:
+        path = Path(module).expanduser()
+        if not path.is_absolute():
+            path = Path(base_dir or Path.cwd()) / path
+        path.is_file()  # raises for a name the system refuses (too long); a missing file is the loader's to report
+        return str(path.resolve())
+    except (OSError, ValueError) as exc:
+        shown = module if len(module) <= 60 else module[:57] + "..."
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ValueError(f"module: the path {shown!r} cannot be resolved ({reason})") from None
 
 
 def anchor_module(data: dict, folder: str | Path) -> dict:
@@ -102,12 +117,20 @@ def anchor_module(data: dict, folder: str | Path) -> dict:
     -------
     dict
         ``data``.
+
+    Raises
+    ------
+    ValueError
+        ``<section>.module: the path ... cannot be resolved (...)``.
     """
     for section in ("controller", "plant"):
         table = data.get(section) if isinstance(data, dict) else None
         module = table.get("module") if isinstance(table, dict) else None
         if isinstance(module, str) and module.endswith(".py"):
-            table["module"] = resolve(module, Path(folder).resolve())
+            try:
+                table["module"] = resolve(module, Path(folder).resolve())
+            except ValueError as exc:
+                raise ValueError(f"{section}.{exc}") from None
     return data
 
 

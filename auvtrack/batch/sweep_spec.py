@@ -134,7 +134,7 @@ class StudyFile(_Model):
     """The keys of a study file (see ``docs/sweeps.md``)."""
 
     name: Annotated[str, Strict()] = "sweep"
-    scenario: Annotated[str, Strict()] = Field(PAPER_SCENARIO, description="'paper' or a TOML path")
+    scenario: Annotated[str, Strict()] = Field(PAPER_SCENARIO, description="a packaged scenario's name or a TOML path")
     set: list[Annotated[str, Strict()]] = Field(default_factory=list)
     seed: Annotated[int, Strict(), Field(ge=0)] = 0
     samples: Annotated[int, Strict(), Field(ge=1, le=MAX_SAMPLES)] = 1
@@ -289,17 +289,17 @@ def _fail(source: str, field: str, text: str) -> StudyError:
 
 
 def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
+    from ..scenario.catalog import is_scenario_name, scenario_path
     from ..scenario.loader import _default_at, read_toml
     from ..scenario.overrides import apply_overrides, parse_overrides
-    from ..scenario import paper_scenario_path
-
-    path = paper_scenario_path() if study.scenario == PAPER_SCENARIO else (folder / study.scenario)
     from ..user_modules import anchor_module
 
-    try:
+    try:  # a packaged scenario's name (no '/', '.'), else a path relative to the study file
+        path = scenario_path(study.scenario) if is_scenario_name(study.scenario) else (folder / study.scenario)
         raw = anchor_module(read_toml(path), Path(path).parent)  # a plug-in path: relative to its file
-    except ScenarioError as exc:
-        raise _fail(source, "scenario", f"must be 'paper' or a readable scenario TOML file ({exc})") from None
+    except (ScenarioError, ValueError) as exc:
+        raise _fail(source, "scenario", f"must be a packaged scenario's name or a readable scenario TOML file "
+                                        f"({exc})") from None
     try:
         return apply_overrides(raw, parse_overrides(study.set), _default_at)
     except ScenarioError as exc:

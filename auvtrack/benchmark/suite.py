@@ -18,9 +18,12 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import itertools
 import json
 import math
 import re
+import string
+import warnings
 import zlib
 from dataclasses import dataclass, field, replace
 from importlib import resources
@@ -28,9 +31,10 @@ from pathlib import Path
 from typing import Annotated, Any, Mapping
 
 import numpy as np
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
+from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator,
+                      model_validator)
 
-from ..batch.sweep_spec import Distribution
+from ..batch.sweep_spec import Distribution, Normal
 from ..scenario.errors import ScenarioError, translate
 
 __all__ = ["SuiteError", "SuiteFile", "Suite", "Task", "Tier", "Start", "ControllerEntry", "load_suite",
@@ -50,6 +54,25 @@ NonNeg = Annotated[Num, Field(ge=0)]
 Pos = Annotated[Num, Field(gt=0)]
 Text = Annotated[str, Strict()]
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+\-]{0,63}")
+_PRESET_TEXT = re.compile(r"[A-Za-z0-9_.+\-]*")
+MAX_WEIGHT = 1e6
+"""Largest scoring weight (only their ratios matter; larger ones would overflow the weighted sum)."""
+MIN_WEIGHT = 1e-6
+"""Smallest non-zero scoring weight."""
+NORMAL_PROBE_STD = 3.0
+"""A tier's normal draw is checked at its mean and at mean +- this many standard deviations."""
+RUN_KEYS: dict[tuple[str, ...], str] = {
+    ("name",): "the run's name",
+    ("seed",): "each run's scenario seed, from the suite seed and the seed index (runs.parquet records it)",
+    ("controller",): "the controller under test (--controllers, --plugin and gain_preset choose it)",
+    ("reference",): "the task's reference (tasks.<name>.reference)",
+    ("sim", "duration"): "the task's duration (tasks.<name>.duration)",
+    ("initial", "eta"): "the start (tasks.<name>.reference and tiers.<name>.start)",
+    ("initial", "nu"): "the start (tasks.<name>.reference and tiers.<name>.start)",
+}
+"""Scenario keys the comparison sets on every run itself: no suite key may set them, or a table above them."""
+ELL_KEYS = (("vehicle",), ("vehicle", "l"), ("vehicle", "preset"))
+"""Keys that set the virtual-point offset the start is placed with: fixed per tier (never drawn or cycled)."""
 
 
 class SuiteError(ScenarioError):
@@ -66,7 +89,7 @@ class Start(_Model):
     along: NonNeg = Field(0.0, description="m, along the reference's initial tangent")
     lateral: NonNeg = Field(0.0, description="m, horizontal, to starboard of the tangent")
     vertical: NonNeg = Field(0.0, description="m, down")
-    heading: NonNeg = Field(0.0, description="rad, added to the tangent's heading")
+    heading: Annotated[Num, Field(ge=0, le=math.pi)] = Field(0.0, description="rad, added to the tangent's heading")
     speed: Annotated[Num, Field(ge=0, lt=1)] = Field(0.0, description="fraction of the reference speed")
 
 
@@ -76,6 +99,44 @@ class Task(_Model):
     description: Text = ""
     duration: Pos
     reference: dict[str, Any]
+
+    @field_validator("reference")
+    @classmethod
+    def _reference(cls, v: dict[str, Any]) -> dict[str, Any]:
+        """The reference module's own validation, and a start in motion (the start is placed along it)."""
+        from ..scenario.components import check_reference
+
+        resolved = check_reference(v)
+        _, vel = _reference_start(json.dumps(resolved, sort_keys=True))
+        if not float(np.linalg.norm(vel)) > 0.0:
+            raise ValueError(f"starts at rest (kind {resolved.get('kind')!r}); a task needs a moving reference, "
+                             "its start is placed along the initial tangent")
+        return v  # as written: the runs resolve it, and the fingerprint stays that of the file
+
+
+def _key_path(key: str) -> tuple[str, ...]:
+    from ..scenario.overrides import parse_overrides
+
+    return tuple(str(p) for p in parse_overrides({key: 0})[0].path)
+
+
+def _overlaps(a: tuple[str, ...], b: tuple[str, ...]) -> bool:
+    """True when one key path is the other or lies below it."""
+    n = min(len(a), len(b))
+    return a[:n] == b[:n]
+
+
+def _check_run_keys(section: str, keys, fixed_only: bool = False) -> None:
+    """Refuse suite keys that would overwrite what the comparison sets per run (and, drawn or cycled, ℓ)."""
+    for key in keys:
+        path = _key_path(key)
+        for owned, what in RUN_KEYS.items():
+            if _overlaps(path, owned):
+                raise ValueError(f"{section}: {key!r} would overwrite {'.'.join(owned)}, which the comparison sets "
+                                 f"for every run: {what}")
+        if fixed_only and any(_overlaps(path, k) for k in ELL_KEYS):
+            raise ValueError(f"{section}: {key!r} cannot vary between seeds: the start is placed with vehicle.l, "
+                             "fixed per tier (give it in [base] or the tier's set)")
 
 
 class Tier(_Model):
@@ -102,6 +163,7 @@ class Tier(_Model):
                 if key in seen and section != "set":
                     raise ValueError(f"{section}: {key!r} is given twice")
                 seen.add(key)
+            _check_run_keys(section, keys, fixed_only=section != "set")
         return self
 
 
@@ -118,6 +180,11 @@ class Scoring(_Model):
 
     @model_validator(mode="after")
     def _some(self) -> "Scoring":
+        for c in CRITERIA:
+            w = getattr(self, c)
+            if w != 0 and not MIN_WEIGHT <= w <= MAX_WEIGHT:
+                raise ValueError(f"{c}: must be 0 or in [{MIN_WEIGHT:g}, {MAX_WEIGHT:g}] (only the ratios of the "
+                                 f"weights matter) (got {w:g})")
         if not any(getattr(self, c) > 0 for c in CRITERIA):
             raise ValueError("must give at least one criterion a weight > 0")
         return self
@@ -174,9 +241,29 @@ class SuiteFile(_Model):
             for n in names:
                 if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,31}", n):
                     raise ValueError(f"{section}.{n}: a name must be a letter then letters, digits or _")
-        if "{kind}" not in self.gain_preset:
-            raise ValueError(f"gain_preset: must contain '{{kind}}' (got {self.gain_preset!r})")
+        _check_gain_preset(self.gain_preset)
+        for key in self.base:
+            try:
+                _key_path(key)
+            except ScenarioError:
+                raise ValueError(f"base: {key!r} is not a dotted scenario key") from None
+        _check_run_keys("base", self.base)
         return self
+
+
+def _check_gain_preset(pattern: str) -> None:
+    """A gain-preset name pattern: name characters and the field ``{kind}``, nothing else."""
+    rule = (f"gain_preset: must be a preset name with {{kind}} in it: letters, digits, _ . + - and the field "
+            f"{{kind}}, no other {{}} field or format (got {pattern!r})")
+    try:
+        parts = list(string.Formatter().parse(pattern))
+    except ValueError:
+        raise ValueError(rule) from None
+    fields = [f for _, f, _, _ in parts if f is not None]
+    if not fields or any(f != "kind" or spec or conv for _, f, spec, conv in parts if f is not None):
+        raise ValueError(rule)
+    if not all(_PRESET_TEXT.fullmatch(text) for text, _, _, _ in parts):
+        raise ValueError(rule)
 
 
 @dataclass(frozen=True)
@@ -374,6 +461,21 @@ def _reference_start(spec: str) -> tuple[np.ndarray, np.ndarray]:
     return p, v
 
 
+def _tier_ell(sf: SuiteFile, tier: str) -> float:
+    """``vehicle.l`` of [base] with the tier's set (the preset's when neither gives it)."""
+    keys = {k: v for k, v in {**sf.base, **sf.tiers[tier].set}.items()
+            if any(_overlaps(_key_path(k), e) for e in ELL_KEYS)}
+    return _vehicle_l(json.dumps(keys, sort_keys=True))
+
+
+@functools.lru_cache(maxsize=64)
+def _vehicle_l(vehicle_overrides: str) -> float:
+    """``vehicle.l`` of the scenario these vehicle overrides (JSON) give (the preset's when unset)."""
+    from ..scenario import load_scenario
+
+    return float(load_scenario({}, json.loads(vehicle_overrides)).vehicle.l)
+
+
 def _generator(seed: int, purpose: str, index: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence([seed, zlib.crc32(purpose.encode()), index]))
 
@@ -399,6 +501,7 @@ class Suite:
     quick: bool = False
     text: str = field(default="", repr=False)
     _skipped: tuple[tuple[str, str], ...] = field(default=(), repr=False)
+    _ells: tuple[tuple[str, float], ...] = field(default=(), repr=False)
 
     # ---------------------------------------------------------------- shape
     @property
@@ -477,6 +580,22 @@ class Suite:
             vals[key] = options[index % len(options)]
         return vals
 
+    def ell(self, tier: str) -> float:
+        """Virtual-point offset (m) the starts of ``tier`` are placed with: ``vehicle.l`` of [base] and its set.
+
+        Parameters
+        ----------
+        tier : str
+            A tier of the suite.
+
+        Returns
+        -------
+        float
+            The effective ``vehicle.l`` (the preset's unless given).
+        """
+        known = dict(self._ells)
+        return known[tier] if tier in known else _tier_ell(self.file, tier)
+
     def conditions(self, task: str, tier: str, index: int) -> tuple[dict, dict, dict]:
         """What one seed index of a (task, tier) cell imposes, whatever the controller.
 
@@ -494,7 +613,7 @@ class Suite:
             and the values this seed drew (start offsets and tier values), for the record.
         """
         tk, tr = self.file.tasks[task], self.file.tiers[tier]
-        ell = float(self.file.base.get("vehicle.l", 1.0))
+        ell = self.ell(tier)
         unit = self.unit_draws(task, index)
         eta, nu = start_state(tk.reference, tr.start, unit, ell)
         raw = {"seed": self.scenario_seed(task, index), "sim": {"duration": self.duration(task)},
@@ -560,29 +679,115 @@ def available_suites() -> list[str]:
     return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml")) if root.is_dir() else []
 
 
-def _check_runs(suite: Suite) -> None:
-    """Validate every (task, tier) scenario of seed index 0 and each random range's ends."""
-    from ..scenario import load_scenario
+def _reason(exc: Exception) -> str:
+    """A scenario error without the ``<dict>: `` source and the override hint (the suite's keys are not overrides)."""
+    text = re.sub(r"^<dict>: ", "", " ".join(str(exc).split()))
+    text = re.sub(r"--set (limits\.\w+)=N or a \[limits\] table", r'"\1" in [base]', text)
+    return re.sub(r" \(set by override [^)]*\)", "", text)
 
-    entry = ControllerEntry("probe", {"kind": "fxtntsmc"}, "")
+
+def _blame(suite: Suite, task: str, tier: str, where: str, exc: Exception) -> SuiteError:
+    """One line naming the file and the suite field behind a refused probe scenario.
+
+    The task's own keys (its duration and reference) and the start are named as such; anything
+    else is the tier's ``where`` (``set``, ``random.<key>``, ``cycle.<key>.<i>``), which holds
+    the [base] keys too.
+    """
+    path = getattr(exc, "path", "") or ""
+    if path == "sim.duration" or path.startswith("reference"):
+        field = f"tasks.{task}.{'duration' if path == 'sim.duration' else 'reference'}"
+        return SuiteError(f"{suite.source}: {field}: under tier {tier!r} the scenario refuses it: {_reason(exc)}")
+    if path.startswith("initial."):
+        where = "start"
+    return SuiteError(f"{suite.source}: tiers.{tier}.{where} on task {task!r}: the scenario refuses it: "
+                      f"{_reason(exc)}")
+
+
+def _check_starts(suite: Suite, task: str, tier: str) -> None:
+    """Every start the tier can draw is a valid initial state: the offsets at their half-widths, all signs."""
+    from ..scenario.errors import translate as _translate
+    from ..scenario.schema import InitialSection
+
+    tk, start = suite.file.tasks[task], suite.file.tiers[tier].start
+    axes = [a for a in START_AXES if getattr(start, a) > 0]
+    for ends in itertools.product((0.0, 1.0), repeat=len(axes)):
+        unit = {a: 0.5 for a in START_AXES} | dict(zip(axes, ends))
+        eta, nu = start_state(tk.reference, start, unit, suite.ell(tier))
+        try:
+            InitialSection.model_validate({"eta": eta, "nu": nu})
+        except ValidationError as exc:
+            err = _translate(exc, InitialSection)
+            raise SuiteError(f"{suite.source}: tiers.{tier}.start: on task {task!r} the start offsets can put "
+                             f"initial.{err}") from None
+
+
+def _prepared_probe(suite: Suite, entries: list[ControllerEntry], task: str, tier: str, where: str,
+                    overrides: dict):
+    """The probe's run prepared for the first competitor that accepts it (schema, run plan, set-up).
+
+    A schema error does not depend on the controller (the suite cannot set ``controller``); a
+    run plan or set-up refusal by every competitor means every run of the cell would fail.
+    """
+    from ..scenario import load_scenario
+    from ..simulation.pipeline import prepare
+
+    first: Exception | None = None
+    for entry in entries:
+        raw, _, _ = suite.scenario(entry, task, tier, 0)
+        try:
+            sc = load_scenario(raw, overrides)
+        except ScenarioError as exc:
+            raise _blame(suite, task, tier, where, exc) from None
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                return prepare(sc)
+        except (ValueError, ImportError, TypeError) as exc:
+            first = first or exc
+    assert first is not None
+    raise _blame(suite, task, tier, where, first) from None
+
+
+def _probe_values(dist) -> list[tuple[str, float]]:
+    """(what, value) pairs at which a tier's random key is checked."""
+    out = [("the range's end" if not isinstance(dist, Normal) else "the mean", float(v)) for v in dist.probes()]
+    if isinstance(dist, Normal):
+        out += [(f"mean {sign} {NORMAL_PROBE_STD:g} std", dist.mean + k * NORMAL_PROBE_STD * dist.std)
+                for sign, k in (("-", -1.0), ("+", 1.0))]
+    return out
+
+
+def _check_runs(suite: Suite) -> None:
+    """Check that every (task, tier) cell can run, as ``auvtrack check`` would check its scenarios.
+
+    Per cell: every start the tier can draw (:func:`_check_starts`); the scenario of seed index 0
+    with the tier's fixed values through loading, the run plan and the set-up of the default
+    competitors (one of them must accept it); each cycled value the same way; each random key at
+    the ends of its range (a normal at its mean and mean +- :data:`NORMAL_PROBE_STD` std) through
+    loading and the run plan.  Messages name the file, the task or tier field and the task.
+    """
+    from ..scenario import load_scenario
+    from ..scenario.plan import plan_run
+
+    entries = resolve_controllers(None, gain_preset=suite.file.gain_preset)
     for task in suite.tasks:
         for tier in suite.tiers:
-            raw, ov, _ = suite.scenario(entry, task, tier, 0)
             tr = suite.file.tiers[tier]
-            ov = {k: v for k, v in ov.items() if k not in tr.random}  # the random keys probed one by one
-            probes = [("set", ov)]
-            for key, dist in suite.file.tiers[tier].random.items():
-                for end in dist.probes():
-                    probes.append((f"random.{key}", {**ov, key: end}))
-            for key, options in suite.file.tiers[tier].cycle.items():
+            _check_starts(suite, task, tier)
+            _, ov, _ = suite.conditions(task, tier, 0)
+            fixed = {k: v for k, v in ov.items() if k not in tr.random and k not in tr.cycle}
+            prep = _prepared_probe(suite, entries, task, tier, "set", fixed)
+            for key, options in tr.cycle.items():
                 for j, v in enumerate(options):
-                    probes.append((f"cycle.{key}.{j}", {**ov, key: v}))
-            for where, overrides in probes:
-                try:
-                    load_scenario(raw, overrides)
-                except ScenarioError as exc:
-                    raise SuiteError(f"{suite.source}: tiers.{tier}.{where} on task {task!r}: the scenario rejects "
-                                     f"it: {exc}") from None
+                    _prepared_probe(suite, entries, task, tier, f"cycle.{key}.{j}", {**fixed, key: v})
+            raw, _, _ = suite.scenario(entries[0], task, tier, 0)
+            for key, dist in tr.random.items():
+                for what, v in _probe_values(dist):
+                    try:
+                        plan_run(load_scenario(raw, {**fixed, key: v}), len(prep.channels))
+                    except ScenarioError as exc:
+                        raise SuiteError(f"{suite.source}: tiers.{tier}.random.{key}: on task {task!r} {what} "
+                                         f"{v:g} is refused: {_reason(exc)}") from None
 
 
 def load_suite(name: str | Path = DEFAULT_SUITE, *, check: bool = True) -> Suite:
@@ -607,7 +812,8 @@ def load_suite(name: str | Path = DEFAULT_SUITE, *, check: bool = True) -> Suite
         One line naming the file, the field and the rule.
     """
     from ..plant import PLANTS
-    from ..scenario.loader import read_toml
+    from ..scenario.loader import parse_toml_text
+    from ..scenario.reading import read_bounded
 
     label = str(name)
     if label in available_suites():
@@ -618,8 +824,12 @@ def load_suite(name: str | Path = DEFAULT_SUITE, *, check: bool = True) -> Suite
         raise SuiteError(f"--suite: unknown suite {label!r} (shipped: {', '.join(available_suites()) or 'none'}; "
                          "or a path to a .toml file)")
     try:
-        raw = read_toml(path)
-        text = path.read_text(encoding="utf-8")
+        data = read_bounded(path, source)
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise ScenarioError(f"{source}: not a UTF-8 text file") from None
+        raw = parse_toml_text(text, source)
     except ScenarioError as exc:
         raise SuiteError(str(exc)) from None
     try:
@@ -630,7 +840,11 @@ def load_suite(name: str | Path = DEFAULT_SUITE, *, check: bool = True) -> Suite
         raise SuiteError(msg, err.path) from None
     skipped = tuple((t, f"plant model {tr.requires_plant!r} is not available in this build")
                     for t, tr in sf.tiers.items() if tr.requires_plant and tr.requires_plant not in PLANTS)
-    suite = Suite(sf, source, False, text, skipped)
+    try:
+        ells = tuple((t, _tier_ell(sf, t)) for t in sf.tiers if t not in dict(skipped))
+    except ScenarioError as exc:
+        raise SuiteError(f"{source}: base or a tier's set: its vehicle keys are refused: {_reason(exc)}") from None
+    suite = Suite(sf, source, False, text, skipped, ells)
     if not suite.tiers:
         raise SuiteError(f"{source}: tiers: none can run in this build ({'; '.join(r for _, r in skipped)})")
     if check:

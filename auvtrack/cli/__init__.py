@@ -1,4 +1,4 @@
-"""Command line: ``auvtrack reproduce | run | check | bounds | study | sweep | compare | bench | warmup``.
+"""Command line: ``auvtrack reproduce | run | check | bounds | scenarios | study | sweep | compare | bench | warmup``.
 
 Bad input (a scenario error, a missing file, an invalid gain, a run over the plan's limits, an
 output folder that cannot be written) prints ONE line to stderr and exits with status 2, never a
@@ -17,10 +17,10 @@ import warnings
 
 import click
 
-from . import compare, perf, run, studies, sweep  # noqa: F401  (each registers its commands on the group)
-from .common import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_SIM_FAILED, VERBOSE, cli, one_line
+from . import compare, perf, run, scenarios, studies, sweep  # noqa: F401  (each registers its commands on the group)
+from .common import EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_SIM_FAILED, VERBOSE, cli, one_line
 
-__all__ = ["cli", "main", "EXIT_BAD_INPUT", "EXIT_SIM_FAILED", "EXIT_INTERRUPTED"]
+__all__ = ["cli", "main", "EXIT_BAD_INPUT", "EXIT_SIM_FAILED", "EXIT_INTERRUPTED", "EXIT_CODES"]
 
 
 def _details(text: str) -> None:

@@ -30,6 +30,7 @@ class BadInput(click.ClickException):
 
 
 def load_arg(scenario: str, overrides: tuple[str, ...]):
+    """The validated scenario of a command's SCENARIO argument (a file or a packaged name) and its --set."""
     from ..scenario import load_scenario
 
     return load_scenario(scenario, list(overrides))
@@ -49,10 +50,12 @@ def prepare_arg(scenario: str, sc):
 
 
 def mib(n: int) -> str:
+    """``n`` bytes in MiB, three significant digits."""
     return f"{n / 2 ** 20:.3g} MiB"
 
 
 def one_line(exc: BaseException) -> str:
+    """The message of ``exc`` on one line (its type name when it has none)."""
     return " ".join(str(exc).split()) or type(exc).__name__
 
 
@@ -63,7 +66,7 @@ EXIT_CODES = (("0", "success"),
               ("130", "interrupted (Ctrl-C): a run keeps its partial result, a sweep or a comparison its "
                       "completed chunks"))
 EXIT_CODES_HELP = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + "."
-COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "study", "sweep", "compare", "bench", "warmup")
+COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "scenarios", "study", "sweep", "compare", "bench", "warmup")
 
 
 def _first_paragraph(text: str | None) -> str:
@@ -95,8 +98,10 @@ class _Group(click.Group):
 def cli(verbose: bool) -> None:
     """auvtrack: trajectory-tracking control of underactuated AUVs.
 
-    Scenarios are TOML files in which every key has a default (docs/scenarios.md); an empty
-    file is the paper's Section 4.  Start with `auvtrack reproduce`.  The first command after
+    Scenarios are TOML files in which every key has a default; an empty file is the paper's
+    Section 4.  The packaged ones run by name from any folder (`auvtrack run paper`), and
+    `auvtrack scenarios copy paper` writes the commented Section 4 file to edit.  Start with
+    `auvtrack reproduce`.  The first command after
     installing or editing the package compiles the Numba kernels (about a minute, more on a
     loaded machine; cached on disk afterwards); `auvtrack warmup` does that up front.
     """

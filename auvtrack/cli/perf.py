@@ -2,11 +2,57 @@
 from __future__ import annotations
 
 import json
+import math
+import re
 from pathlib import Path
 
 import click
 
-from .common import MAX_REPEAT, BadInput, cli
+from .common import MAX_REPEAT, BadInput, cli, one_line
+
+
+def _option_given(name: str) -> bool:
+    """True when the user gave option ``name`` (not its default)."""
+    ctx = click.get_current_context()
+    return ctx.get_parameter_source(name) not in (None, click.core.ParameterSource.DEFAULT)
+
+
+def _check_controllers(controllers: tuple[str, ...], plant: str) -> None:
+    """Each ``--controller`` is a built-in kind that runs on ``plant``, or ``plugin:FILE.py``."""
+    from ..control import BUILTIN_NAMES
+    from ..simulation.compiling import builtin_controllers
+
+    runs_here = builtin_controllers(plant)
+    for kind in controllers:
+        if kind.startswith("plugin:"):
+            continue
+        if kind not in BUILTIN_NAMES:
+            raise BadInput(f"--controller: unknown controller {kind!r} (allowed: {', '.join(BUILTIN_NAMES)}, "
+                           "or plugin:FILE.py)")
+        if kind not in runs_here:
+            raise BadInput(f"--controller: {kind} does not run on --plant {plant} (controllers that do: "
+                           f"{', '.join(runs_here)})")
+
+
+def _scenario_reason(exc: Exception) -> str:
+    """A scenario error without its source and override hint: what the option's value breaks."""
+    text = one_line(exc)
+    text = re.sub(r"^(?:<dict>|[^:]*\.toml): ", "", text)
+    text = re.sub(r" \(raise it deliberately[^)]*\)", "", text)  # bench has no --set
+    return re.sub(r" \(set by override '[^']*'\)", "", text)
+
+
+def _check_duration(duration: float, plant: str) -> None:
+    """``--duration`` is a finite time the bench's scenarios on ``plant`` accept (time grid, run plan)."""
+    from ..perf.bench import PLANT_BENCH, _prepared
+
+    if not (math.isfinite(duration) and duration > 0):
+        raise BadInput(f"--duration: must be a finite number > 0 s (got {duration:g})")
+    for source, extra in PLANT_BENCH[plant]:
+        try:
+            _prepared("ftsmc", duration, source, extra)  # any controller: the grid and the plan are the scenario's
+        except ValueError as exc:
+            raise BadInput(f"--duration: a {duration:g} s run is refused: {_scenario_reason(exc)}") from None
 
 
 @cli.command()
@@ -32,8 +78,16 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
     """
     if not 1 <= repeat <= MAX_REPEAT:
         raise BadInput(f"--repeat: must be in [1, {MAX_REPEAT}] (a median needs at least one timing) (got {repeat})")
-    if not duration > 0:
-        raise BadInput(f"--duration: must be > 0 s (got {duration:g})")
+    if run_all:
+        unused = [option for option, param in (("--controller", "controllers"), ("--duration", "duration"),
+                                               ("--plant", "plant")) if _option_given(param)]
+        if unused:
+            raise BadInput(f"{', '.join(unused)}: not used by --all (it runs its own fixed suite)")
+    else:
+        if bench_out is not None:
+            raise BadInput("--out: only --all writes results (without it, bench prints JSON lines)")
+        _check_controllers(controllers, plant)
+        _check_duration(duration, plant)
 
     if run_all:
         from ..perf.bench import bench_all
@@ -64,6 +118,15 @@ def warmup(controllers: tuple[str, ...], plants: tuple[str, ...], simd: bool) ->
     The first command after installing or editing the package compiles the kernels it needs
     (about a minute, more on a loaded machine); warmup does it for every command up front.
     """
-    from ..simulation.compiling import warmup as _warmup
+    from ..control import BUILTIN_NAMES
+    from ..plant import BUILTIN_NAMES as PLANT_NAMES
+    from ..simulation.compiling import builtin_pairs, warmup as _warmup
 
+    for option, given, allowed in (("--controller", controllers, BUILTIN_NAMES), ("--plant", plants, PLANT_NAMES)):
+        for name in given:
+            if name not in allowed:
+                raise BadInput(f"{option}: unknown {option[2:]} {name!r} (allowed: {', '.join(allowed)})")
+    if not builtin_pairs(controllers, plants):
+        raise BadInput(f"--controller, --plant: nothing to compile: no controller given runs on a plant given "
+                       f"({', '.join(controllers)} on {', '.join(plants)})")
     click.echo(json.dumps(_warmup(controllers, plants, progress=True, simd=simd)))

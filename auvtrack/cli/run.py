@@ -18,11 +18,12 @@ from .common import (EXIT_CODES_HELP, EXIT_INTERRUPTED, EXIT_SIM_FAILED, LONG_RU
 @set_option
 @click.option("--mat", is_flag=True, help="Also write trajectory.mat (MATLAB).")
 def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -> None:
-    """Simulate SCENARIO (a TOML file) and write trajectory.csv, run.json and scenario.toml to a run folder.
+    """Simulate SCENARIO (a TOML file or a packaged name): trajectory.csv, run.json, scenario.toml in a run folder.
 
     Without --out every run gets a new folder runs/<name>-<controller> (then -2, -3, ...), so a
     second run never overwrites the first; the folder is printed.  The folder is checked before
     the simulation starts, and scenario.toml reproduces the run (auvtrack run <folder>/scenario.toml).
+    A name (auvtrack scenarios list) has no '/' and no '.'; paper.toml or ./paper is a file.
     """
     from ..control import spec_for
     from ..simulation.compiling import ensure_compiled

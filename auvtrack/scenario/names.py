@@ -33,5 +33,6 @@ def check_name(value: str) -> str:
         ``"must be <rule> (got <value>)"``.
     """
     if not isinstance(value, str) or not _NAME.fullmatch(value) or ".." in value:
-        raise ValueError(f"must be {NAME_RULE}, without '..' (got {value!r})")
+        shown = repr(value) if not isinstance(value, str) or len(value) <= 60 else repr(value[:57] + "...")
+        raise ValueError(f"must be {NAME_RULE}, without '..' (got {shown})")
     return value

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Sequence
 
 from .errors import ScenarioError, format_value
+from .reading import MAX_FILE_BYTES, MAX_NESTING, check_nesting, check_text_nesting, override_value
 
 __all__ = ["Override", "parse_overrides", "apply_overrides", "KIND_DEFAULTS"]
 
@@ -61,12 +62,15 @@ class Override:
 
 def _parse_path(key: str, text: str) -> tuple[Segment, ...]:
     parts = key.strip().split(".")
+    if len(parts) > MAX_NESTING:
+        raise ScenarioError(f"override {_short(text)}: a key of more than {MAX_NESTING} parts "
+                            f"(got {len(parts)})")
     for p in parts:
         if not _SEGMENT.match(p):
-            raise ScenarioError(f"override {text!r}: bad key segment {p!r} (use dotted.key=value, "
+            raise ScenarioError(f"override {_short(text)}: bad key segment {_short(p)} (use dotted.key=value, "
                                 f"indices as numbers: disturbance.0.amplitude=2)")
     if parts[0].isdigit():
-        raise ScenarioError(f"override {text!r}: a key cannot start with an index")
+        raise ScenarioError(f"override {_short(text)}: a key cannot start with an index")
     return tuple(int(p) if p.isdigit() else p for p in parts)
 
 
@@ -78,15 +82,28 @@ def parse_value(text: str) -> Any:
     ValueError
         The text is neither a TOML value nor a bare word.
     """
+    if len(text) > MAX_FILE_BYTES:
+        raise ValueError(f"longer than the {MAX_FILE_BYTES} characters a value may have")
     try:
+        check_text_nesting(f"v = {text}", "value")
         doc = tomllib.loads(f"v = {text}")
+    except ScenarioError as exc:
+        raise ValueError(str(exc).removeprefix("value: ")) from None
     except tomllib.TOMLDecodeError as exc:
         if _BARE_WORD.match(text) or _BARE_PATH.match(text):
             return text
         raise ValueError(f"not a TOML value ({exc})") from None
+    except ValueError as exc:  # e.g. an integer over sys.get_int_max_str_digits()
+        raise ValueError(f"not a value Python can hold ({' '.join(str(exc).split())})") from None
     if set(doc) != {"v"}:
         raise ValueError("not a single TOML value")
+    check_nesting(doc["v"], "value")
     return doc["v"]
+
+
+def _short(text: str, n: int = 60) -> str:
+    """``repr`` of an override for a message, shortened to about ``n`` characters."""
+    return repr(text if len(text) <= n else text[: n - 3] + "...")
 
 
 def parse_overrides(overrides: Sequence[str] | Mapping[str, Any] | str | None) -> list[Override]:
@@ -94,9 +111,12 @@ def parse_overrides(overrides: Sequence[str] | Mapping[str, Any] | str | None) -
 
     Parameters
     ----------
-    overrides : sequence of str, mapping, str or None
-        ``"dotted.key=value"`` strings (a single string is one override) or a mapping
-        ``{dotted_key: value}`` whose values are used as given.
+    overrides : list or tuple of str, str, mapping or None
+        ``"dotted.key=value"`` strings in a list or tuple, a single such string (one override),
+        or a mapping ``{dotted_key: value}`` whose values are TOML values: numbers, booleans,
+        strings, dates, lists and dicts, with NumPy scalars and arrays taken as the Python
+        values they hold (:func:`auvtrack.scenario.reading.override_value`; ``None`` is
+        refused).  None: no overrides.
 
     Returns
     -------
@@ -106,7 +126,9 @@ def parse_overrides(overrides: Sequence[str] | Mapping[str, Any] | str | None) -
     Raises
     ------
     ScenarioError
-        A malformed override (no ``=``, empty key, bad segment, unparseable value).
+        Overrides of another type (a set, bytes, an array of strings...), a malformed override
+        (no ``=``, empty key, bad segment, unparseable value, a value that is not a TOML value),
+        or a key or value nested beyond :data:`~auvtrack.scenario.reading.MAX_NESTING`.
     """
     if overrides is None:
         return []
@@ -115,27 +137,32 @@ def parse_overrides(overrides: Sequence[str] | Mapping[str, Any] | str | None) -
     out: list[Override] = []
     if isinstance(overrides, Mapping):
         for key, value in overrides.items():
-            text = f"{key}={format_value(value)}"
             if not isinstance(key, str) or not key.strip():
-                raise ScenarioError(f"override {text!r}: the key must be a non-empty dotted string")
-            out.append(Override(text, _parse_path(key, text), copy.deepcopy(value)))
+                raise ScenarioError(f"override {format_value(key)}: the key must be a non-empty dotted string")
+            path = _parse_path(key, key)
+            plain = override_value(value, key.strip())
+            out.append(Override(f"{key}={format_value(plain)}", path, plain))
         return out
+    if not isinstance(overrides, (list, tuple)):
+        raise ScenarioError(f"overrides: must be a list of 'dotted.key=value' strings, one such string or a dict "
+                            f"{{dotted.key: value}} (got {type(overrides).__name__})")
     for item in overrides:
         if not isinstance(item, str):
             raise ScenarioError(f"override {format_value(item)}: must be a string 'dotted.key=value'")
         text = item.strip()
         key, sep, raw = text.partition("=")
         if not sep or not key.strip():
-            raise ScenarioError(f"override {text!r}: expected dotted.key=value (e.g. sim.dt=0.002)")
+            raise ScenarioError(f"override {_short(text)}: expected dotted.key=value (e.g. sim.dt=0.002)")
         raw = raw.strip()
         if not raw:
-            raise ScenarioError(f"override {text!r}: missing value after '='")
+            raise ScenarioError(f"override {_short(text)}: missing value after '='")
+        path = _parse_path(key, text)
         try:
             value = parse_value(raw)
         except ValueError as exc:
             tip = "; quote strings with spaces (name=\"my run\")" if " " in raw else ""
-            raise ScenarioError(f"override {text!r}: value {raw!r} is {exc}{tip}") from None
-        out.append(Override(text, _parse_path(key, text), value))
+            raise ScenarioError(f"override {_short(text)}: value {_short(raw)} is {exc}{tip}") from None
+        out.append(Override(text, path, value))
     return out
 
 

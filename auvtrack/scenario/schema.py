@@ -573,11 +573,15 @@ class Scenario(BaseModel):
 
     @model_validator(mode="after")
     def _start_inside_limits(self) -> "Scenario":
-        """A start beyond the pitch limit would stop the run at t = 0."""
+        """A start beyond the pitch or the roll limit would stop the run at t = 0."""
         theta, lim = self.initial.eta[3], self.sim.theta_limit
         if not abs(theta) < math.radians(lim):
             raise ValueError(f"initial.eta.3: abs(theta) must be < sim.theta_limit = {lim:g} deg "
                              f"= {math.radians(lim):.6g} rad (got {format_value(theta)})")
+        phi, lim = self.initial.phi, self.sim.phi_limit
+        if not abs(phi) < math.radians(lim):
+            raise ValueError(f"initial.phi: abs(phi) must be < sim.phi_limit = {lim:g} deg "
+                             f"= {math.radians(lim):.6g} rad (got {format_value(phi)})")
         return self
 
     @model_validator(mode="after")

@@ -399,16 +399,20 @@ def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
     return st
 
 
-def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | Mapping = (), *,
+def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | str | Mapping | None = (), *,
              warn: bool = True) -> Result:
     """Simulate a scenario and return its :class:`Result`.
 
     Parameters
     ----------
     scenario : str, path, dict or Scenario
-        A TOML file, a scenario dict, or a loaded :class:`~auvtrack.scenario.Scenario`.
-    overrides : sequence of str or dict, optional
-        ``"dotted.key=value"`` overrides applied on top (see :func:`auvtrack.load_scenario`).
+        A packaged scenario's name (``"paper"``, ``"lawnmower"``; no ``/``, ``\\`` or ``.``), a
+        TOML file path, a scenario dict, or a loaded :class:`~auvtrack.scenario.Scenario`
+        (:func:`auvtrack.load_scenario`).
+    overrides : list of str, str, dict or None, optional
+        ``"dotted.key=value"`` overrides applied on top: a list or tuple of them, one such
+        string, or a dict ``{dotted.key: value}`` of TOML values (NumPy scalars and arrays are
+        converted, ``None`` is refused); None means none (see :func:`auvtrack.load_scenario`).
     warn : bool, optional
         Emit the controller's set-up notes (e.g. an initial envelope widening) as warnings.
 
@@ -420,13 +424,17 @@ def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | Mapp
 
     Raises
     ------
+    ScenarioError
+        Bad input, a one-line message naming the source and the field (a ``ValueError``).
+    ValueError
+        The run plan or the controller's set-up refuses the scenario (:func:`prepare`).
     SimulationInterrupted
         On Ctrl-C; its ``result`` holds the partial run.
 
     Examples
     --------
     >>> import auvtrack
-    >>> res = auvtrack.simulate("scenarios/paper.toml", ["sim.duration=1"])  # doctest: +SKIP
+    >>> res = auvtrack.simulate("paper", ["sim.duration=1"])  # doctest: +SKIP
     >>> res.to_pandas().head()  # doctest: +SKIP
     """
     sc = load_scenario(scenario, overrides)

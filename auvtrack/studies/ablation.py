@@ -35,6 +35,7 @@ horizon without a failure" (envelope violation, pitch limit, non-finite state, s
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
@@ -177,7 +178,23 @@ def settings_for(quick: bool = False, pulse: str | Sequence[float] | None = None
                 math.isfinite(pulse_start) and pulse_start >= 0):
             raise ValueError(f"--pulse-start: must be a finite number >= 0 s (got {pulse_start!r})")
         st = replace(st, pulse_start=float(pulse_start))
+        _check_horizon(st)
     return st
+
+
+def _check_horizon(st: Settings) -> None:
+    """Refuse a pulse onset whose runs the scenario would refuse (run plan, time grid), naming the option."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            prepare(load_scenario(paper_scenario_path(), {"sim.duration": st.horizon}))  # the run's length alone
+            prepare(_scenario(configurations()[0], st.conditions[0], st.horizon, st.directions[0][1], st,
+                              window=(st.pulse_start, st.horizon)))
+    except ValueError as exc:
+        reason = re.sub(r"^(?:<dict>|\S*\.toml): ", "", " ".join(str(exc).split()))  # without the file's name
+        reason = re.sub(r" \((?:set by override|raise it deliberately)[^)]*\)", "", reason)  # not the user's
+        raise ValueError(f"--pulse-start: a pulse at {st.pulse_start:g} s makes each pulse run last "
+                         f"{st.horizon:g} s, which is refused: {reason}") from None
 
 
 # ------------------------------------------------------------------ survival scan

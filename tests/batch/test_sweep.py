@@ -200,7 +200,7 @@ BAD = [
     ('name = "t"', 'name = "/tmp/abs"', "name: must be 1 to 100 characters"),
     ('name = "t"', 'name = ".."', "name: must be 1 to 100 characters"),
     ('name = "t"', 'name = "a\\u0000b"', "name: must be 1 to 100 characters"),
-    ('scenario = "paper"', 'scenario = "missing.toml"', "scenario: must be 'paper' or a readable"),
+    ('scenario = "paper"', 'scenario = "missing.toml"', "scenario: must be a packaged scenario's name or a readable"),
     ('set = ["sim.duration=0.2", "estimator.neurons=3"]', 'set = ["sim.dt=-1"]', "sim.dt"),
     ('"controller.kind"', '"controller..kind"', "not a dotted scenario key"),
 ]

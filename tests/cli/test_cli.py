@@ -56,7 +56,7 @@ def test_failed_run_exits_3_keeps_the_partial_result_and_says_why(tmp_path, caps
     (["check", str(PAPER), "--set", "sim.dt=0"], "sim.dt"),
     (["bounds", str(PAPER), "--set", "controller.kind=ftsmc"], "controller.kind"),
     (["bench", "--repeat", "0"], "--repeat: must be in [1, 1000]"),
-    (["bench", "--duration", "-1"], "--duration: must be > 0"),
+    (["bench", "--duration", "-1"], "--duration: must be a finite number > 0"),
     (["run", str(PAPER), "--bogus"], "No such option '--bogus'"),  # usage errors are one line too
     (["reproduce", "--out", str(PAPER)], "is a file"),
     (["check", str(PAPER), "--set", "sim.duration=1e7"], "sim.duration: sim.duration / sim.dt"),
