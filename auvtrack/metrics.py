@@ -481,7 +481,7 @@ def path_errors_of_samples(path, t, position, window: float = PATH_WINDOW) -> tu
     between its grid neighbours and polished by Brent's root finding on
     (eta_d(s) - p) . eta_d'(s) = 0.  Where the path stands still it is no part of the path (as in
     the compiled projection); a start there stays there.  The errors are
-    ``R_y(pi_v)^T R_z(pi_h)^T (p - eta_d(s))`` (Fossen & Aguiar 2024, eq. 5-7) with explicit
+    ``R_y(pi_v)^T R_z(pi_h)^T (p - eta_d(s))`` (Fossen & Aguiar 2024; MSS ``ALOS3D``) with explicit
     rotation matrices, and (s - t) |eta_d'(s)|.
 
     Parameters

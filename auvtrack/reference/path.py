@@ -40,7 +40,7 @@ Path frame
 ----------
 At s, with pi_h = atan2(yd', xd') (azimuth of the horizontal tangent) and pi_v = atan2(-zd',
 |(xd', yd')|) (elevation, positive climbing), the errors are those of Fossen & Aguiar (2024),
-eq. (5)-(7) (MSS ``ALOS3D``): e = R_y(pi_v)^T R_z(pi_h)^T (p - eta_d(s)), i.e.
+as in MSS ``ALOS3D``: e = R_y(pi_v)^T R_z(pi_h)^T (p - eta_d(s)), i.e.
 
 * along-track x_e along the 3-D tangent (0 at a closest point: the projection's condition g = 0);
 * cross-track y_e horizontal, perpendicular to the horizontal tangent, positive to the right of
@@ -174,7 +174,7 @@ def path_errors(pt, p):
     -------
     tuple of 3 float
         x_e along the tangent, y_e horizontal and positive to the right of the path, z_e positive
-        below it (m; Fossen & Aguiar 2024, eq. 5-7).  Where the path stands still: (0, the
+        below it (m; Fossen & Aguiar 2024, MSS ``ALOS3D``).  Where the path stands still: (0, the
         horizontal distance, the depth difference).
     """
     dx, dy, dz = p[0] - pt[0][0], p[1] - pt[0][1], p[2] - pt[0][2]
