@@ -22,8 +22,9 @@ terms, r_d = cos(theta) psi_d_dot and q_d = theta_d_dot with (L4)::
     psi_d_dot   = pi_h'(s) s_dot - Delta_h y_e_dot / (Delta_h^2 + y_e^2) - beta_hat_dot
     theta_d_dot = pi_v'(s) s_dot + Delta_v z_e_dot / (Delta_v^2 + z_e^2) + alpha_hat_dot
 
-where s_dot = p_dot . eta_d' / (|eta_d'|^2 + (eta_d - p) . eta_d'') keeps s at the closest point
-and y_e_dot, z_e_dot are p_dot on the path frame's normals.  Speed: the path's speed at s,
+where s_dot = p_dot . eta_d' / (|eta_d'|^2 + (eta_d - p) . eta_d'') is the closest point's rate
+and y_e_dot, z_e_dot are p_dot on the path frame's normals; the state s follows the projection at
+that rate plus K_S (s_projected - s).  Speed: the path's speed at s,
 corrected for the timing error a = (s - t) |eta_d'(s)| (L5)::
 
     u_d = |eta_d'(s)| - k_a a,   clipped to |eta_d'(s)| (1 +- along_max)
@@ -54,9 +55,10 @@ exact for both REMUS 100 truths), T = -a n^2 in reverse.  Every command is clipp
 plant says its actuators can do (``args.lo``, ``args.hi``).
 
 Anti-windup (L9): back-calculation (Astrom & Hagglund 2006, ch. 3) in tau: with Delta the tau
-the clipped command falls short of the demanded one, I_dot = e - (w / (m K_I)) Delta (K_I the
-integral gain per unit inertia), and the ALOS estimates do not adapt while their autopilot's
-actuator is saturated (conditional integration).
+by which the clipped command falls short of the demanded one, I_dot = e - k_aw w Delta / Ki
+(tracking rate k_aw w, ``kaw`` = 1), and the ALOS estimates do not adapt while their autopilot's
+actuator is saturated (conditional integration); ``kaw`` = 0 gives the published forms (textbook
+PID, ALOS without freezing).
 
 Packed gains :data:`GAINS`; state xc = :data:`STATE` (s, beta_hat, alpha_hat, and the integrals
 I_u (m), I_theta, I_psi (rad s)); logged channels :data:`AUX_NAMES`.
@@ -96,7 +98,7 @@ COMMANDS = ("actuators", "tau")
 AUX_NAMES = ("s_path", "xtrack", "vtrack", "psi_d", "theta_d", "u_d", "beta_hat", "alpha_hat", "i_u", "i_theta",
              "i_psi")
 GAINS = packed_layout("LOSAutopilot", actuators=1, delta_h=1, delta_v=1, gamma_h=1, gamma_v=1, adapt_max=1,
-                      crab=1, theta_max=1, k_along=1, along_max=1, wn=3, zeta=3, fin=2, thrust=2, u_min=1)
+                      crab=1, theta_max=1, k_along=1, along_max=1, wn=3, zeta=3, kaw=1, fin=2, thrust=2, u_min=1)
 """Packed gains; ``wn``, ``zeta`` per loop (surge, pitch, yaw); ``fin`` = (c_q, c_r) in N m per (m/s)^2
 per rad; ``thrust`` = (a, b) of T(n, u) = a n^2 + b n u (N per rpm^2, N s per m rpm)."""
 STATE = packed_layout("LOSAutopilotState", s=1, beta_hat=1, alpha_hat=1, i=3)
@@ -139,6 +141,8 @@ class Params(ControllerParams):
     zeta: float = tunable(2.0, 0.3, 4.0, gt=0.05, le=5.0,
                           description="relative damping of the three loops (> 0.05: (L7) Hurwitz)")
     u_min: float = Field(0.3, gt=0, le=5.0, description="speed below which the fin gains stop growing, m/s (L8)")
+    kaw: float = Field(1.0, ge=0, le=100.0, description="back-calculation rate of each integrator as a multiple of "
+                                                        "its loop's wn (L9); 0: the textbook PID, no anti-windup")
 
 
 @njit_noalloc(inline="always")
@@ -171,11 +175,16 @@ def thrust(n, u, a, b):
 
 @njit_noalloc(inline="always")
 def rpm_for(T, u, a, b):
-    """The propeller speed (rpm) giving thrust T at surge speed u: the inverse of :func:`thrust`."""
-    if T >= 0.0:
-        bu = b * u
-        return (-bu + math.sqrt(bu * bu + 4.0 * a * T)) / (2.0 * a)
-    return -math.sqrt(-T / a)
+    """The propeller speed (rpm) giving thrust T at surge speed u: the inverse of :func:`thrust`.
+
+    The larger root of a n^2 + b u n = T on the forward branch; a thrust below that branch's least
+    (-(b u)^2 / 4a when b u < 0) from the reverse branch -a n^2 = T.
+    """
+    bu = b * u
+    disc = bu * bu + 4.0 * a * T
+    if disc >= 0.0 and math.sqrt(disc) >= bu:
+        return (-bu + math.sqrt(disc)) / (2.0 * a)
+    return -math.sqrt(max(-T, 0.0) / a)
 
 
 @njit_noalloc(inline="always")
@@ -206,9 +215,10 @@ def guidance(t, y, xc, path, cp):
     if v2 > SPEED2_MIN:
         den = v2 + (pos[0] - p[0]) * acc[0] + (pos[1] - p[1]) * acc[1] + (pos[2] - p[2]) * acc[2]
         den = den if den >= 0.5 * v2 else v2
-        s_dot = (pd[0] * vx + pd[1] * vy + pd[2] * vz) / den + K_S * (s - xc[STATE.s])
+        s_geo = (pd[0] * vx + pd[1] * vy + pd[2] * vz) / den  # the closest point's rate
     else:  # the path stands still here: the parameter advances with time
-        s_dot = 1.0 + K_S * (s - xc[STATE.s])
+        s_geo = 1.0
+    s_dot = s_geo + K_S * (s - xc[STATE.s])
     ch, sh, cv, sv = math.cos(pi_h), math.sin(pi_h), math.cos(pi_v), math.sin(pi_v)
     ye_dot = -sh * pd[0] + ch * pd[1]
     ze_dot = sv * (ch * pd[0] + sh * pd[1]) + cv * pd[2]
@@ -221,8 +231,8 @@ def guidance(t, y, xc, path, cp):
     a_dot = cp[GAINS.gamma_v] * dv / math.sqrt(dv * dv + z_e * z_e) * z_e
     psi_d = pi_h - xc[STATE.beta_hat] - c * beta_m - math.atan(y_e / dh)
     theta_d = pi_v + xc[STATE.alpha_hat] + c * alpha_m + math.atan(z_e / dv)
-    psi_d_dot = dpi_h * s_dot - dh * ye_dot / (dh * dh + y_e * y_e) - b_dot
-    theta_d_dot = dpi_v * s_dot + dv * ze_dot / (dv * dv + z_e * z_e) + a_dot
+    psi_d_dot = dpi_h * s_geo - dh * ye_dot / (dh * dh + y_e * y_e) - b_dot
+    theta_d_dot = dpi_v * s_geo + dv * ze_dot / (dv * dv + z_e * z_e) + a_dot
     speed = math.sqrt(v2)
     du = cp[GAINS.along_max] * speed
     u_d = _clip(speed - cp[GAINS.k_along] * (s - t) * speed, speed - du, speed + du)
@@ -280,12 +290,12 @@ def control(t, y, xc, args, out):
     out.u[0], out.u[1], out.u[2] = c0, c1, c2
     # (L9) back-calculation with tracking rate wn; (L3) adaptation frozen while the autopilot saturates
     dxc[STATE.s] = s_dot
-    bound = cp[GAINS.adapt_max]
-    dxc[STATE.beta_hat] = _proj(xc[STATE.beta_hat], b_dot, bound) if dr == 0.0 else 0.0
-    dxc[STATE.alpha_hat] = _proj(xc[STATE.alpha_hat], a_dot, bound) if dq == 0.0 else 0.0
-    dxc[STATE.i] = e_u - cp[wn] / ki_u * du
-    dxc[STATE.i + 1] = e_q - cp[wn + 1] / ki_q * dq
-    dxc[STATE.i + 2] = e_r - cp[wn + 2] / ki_r * dr
+    bound, kaw = cp[GAINS.adapt_max], cp[GAINS.kaw]
+    dxc[STATE.beta_hat] = _proj(xc[STATE.beta_hat], b_dot, bound) if dr == 0.0 or kaw == 0.0 else 0.0
+    dxc[STATE.alpha_hat] = _proj(xc[STATE.alpha_hat], a_dot, bound) if dq == 0.0 or kaw == 0.0 else 0.0
+    dxc[STATE.i] = e_u - kaw * cp[wn] / ki_u * du
+    dxc[STATE.i + 1] = e_q - kaw * cp[wn + 1] / ki_q * dq
+    dxc[STATE.i + 2] = e_r - kaw * cp[wn + 2] / ki_r * dr
     aux = out.aux
     aux[0], aux[1], aux[2], aux[3] = s, y_e, z_e, psi_d
     aux[4], aux[5], aux[6], aux[7] = theta_c, u_d, xc[STATE.beta_hat], xc[STATE.alpha_hat]
@@ -450,7 +460,7 @@ def setup(params: Params, ctx) -> CompiledController:
     cp = GAINS.pack(actuators=float(actuators), delta_h=p.delta_h, delta_v=p.delta_v, gamma_h=p.gamma_h,
                     gamma_v=p.gamma_v, adapt_max=p.adapt_max, crab=p.crab, theta_max=p.theta_max, k_along=p.k_along,
                     along_max=p.along_max, wn=(p.wn_u, p.wn_theta, p.wn_psi), zeta=(p.zeta, p.zeta, p.zeta),
-                    fin=fin, thrust=thr, u_min=p.u_min)
+                    kaw=p.kaw, fin=fin, thrust=thr, u_min=p.u_min)
     nu = tuple(float(v) for v in ctx.nu0)
     xc0 = np.zeros(STATE.size)  # s(0) = 0: the first projection searches from the reference's start time
     if actuators:
