@@ -117,9 +117,9 @@ class Params(ControllerParams):
     """ALOS path following with PID autopilots placed on the design model (docs/controllers.md, eq. L1-L9)."""
 
     kind: Literal["los_autopilot"] = "los_autopilot"
-    delta_h: float = tunable(5.0, 1.0, 40.0, log=True, gt=0, le=1e3,
+    delta_h: float = tunable(3.0, 1.0, 40.0, log=True, gt=0, le=1e3,
                              description="horizontal look-ahead distance Delta_h, m (L1)")
-    delta_v: float = tunable(5.0, 1.0, 40.0, log=True, gt=0, le=1e3,
+    delta_v: float = tunable(3.0, 1.0, 40.0, log=True, gt=0, le=1e3,
                              description="vertical look-ahead distance Delta_v, m (L2)")
     gamma_h: float = tunable(0.001, 0.0, 0.05, ge=0, le=1.0,
                              description="ALOS adaptation gain of the crab-angle estimate, 1/(m s) (L3)")
