@@ -88,7 +88,7 @@ from pydantic import Field
 
 from ..jit import njit_noalloc
 from ..packing import packed_layout
-from ..reference.path import path_errors, project
+from ..reference.path import SPEED2_MIN, path_errors, project
 from ..vehicle.kinematics import eta_dot
 from ..vehicle.params import VP
 from .registry import CompiledController, ControllerParams, tunable
@@ -110,7 +110,6 @@ WINDOW = 10.0
 """Half-width (s of path time) of the projection's search around the state s."""
 ADAPT_EPS = 0.01
 """Width (rad) of the projection band beyond adapt_max (Krstic et al. 1995, App. E)."""
-SPEED2_MIN = 1e-20  # (m/s)^2: the path stands still
 
 
 class Params(ControllerParams):
@@ -142,7 +141,8 @@ class Params(ControllerParams):
                           description="relative damping of the three loops (> 0.05: (L7) Hurwitz)")
     u_min: float = Field(0.3, gt=0, le=5.0, description="speed below which the fin gains stop growing, m/s (L8)")
     kaw: float = Field(1.0, ge=0, le=100.0, description="back-calculation rate of each integrator as a multiple of "
-                                                        "its loop's wn (L9); 0: the textbook PID, no anti-windup")
+                                                        "its loop's wn (L9); 0: the published forms (textbook PID, "
+                                                        "ALOS adapting in saturation)")
 
 
 @njit_noalloc(inline="always")

@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 import auvtrack
 from auvtrack.control import los_autopilot as los
 from auvtrack.control.contract import Measured, evaluate
-from auvtrack.reference import Circle, Lawnmower, Line
+from auvtrack.reference import Circle, Line
 from auvtrack.reference.path import path_errors, project
 from auvtrack.studies.model_gap import start_pose
 from auvtrack.vehicle.dynamics import nu_dot
@@ -261,6 +261,16 @@ def test_the_plants_own_propeller_and_fins_give_the_demanded_tau(preset):
         assert got[0] == pytest.approx(tau[0], rel=1e-9)
 
 
+@settings(max_examples=200)
+@given(a=st.floats(1e-7, 1e-3), b=st.floats(-0.05, 0.05), u=st.floats(0.0, 3.0), x=st.floats(0.0, 2000.0))
+def test_rpm_for_inverts_the_thrust_curve_on_its_forward_branch(a, b, u, x):
+    """T(n, u) = a n^2 + b n u is monotone for n >= max(0, -b u / 2a): there rpm_for(T(n, u), u) = n."""
+    n = max(0.0, -b * u / (2 * a)) + x
+    T = los.thrust(n, u, a, b)
+    assert los.rpm_for(T, u, a, b) == pytest.approx(n, rel=1e-9, abs=1e-9 * (1.0 + abs(b * u) / a))
+    assert los.thrust(-n, u, a, b) == pytest.approx(-a * n * n)
+
+
 # ------------------------------------------------------------------ whole runs
 def _lawnmower(truth, legs=3, controller=None, duration=None, delta_max=None):
     ref = {"kind": "lawnmower", "start": [0.0, 0.0], "heading": 0.0, "leg_length": 20.0, "spacing": 60.0,
@@ -348,7 +358,7 @@ def test_a_batch_equals_single_runs(backend):
     cases += [five, {**five, "controller": {"kind": "los_autopilot", "wn_psi": 2.0}}]
     preps = [prepare(load_scenario(c)) for c in cases]
     singles = [run_prepared(p) for p in preps]
-    for s, r in zip(run_batch(preps, backend=backend, workers=2), singles):
+    for s, r in zip(run_batch(preps, backend=backend, workers=2), singles, strict=True):
         assert s.status == r.status
         a = np.array([s.metrics[k] for k in METRIC_NAMES])
         b = np.array([r.metrics[k] for k in METRIC_NAMES])
