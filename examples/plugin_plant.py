@@ -97,6 +97,12 @@ def feedback(x, cmd, pp):
 
 
 @njit_noalloc
+def effort(x, cmd, pp):
+    """|tau_u| / tau_max_u, 0 (no actuator in pitch), |tau_r| / tau_max_r (0 without limits)."""
+    return abs(cmd[0]) / pp[PARAMS.tau_max], 0.0, abs(cmd[2]) / pp[PARAMS.tau_max + 1]
+
+
+@njit_noalloc
 def attitude_cause(x, sf):
     """A level vehicle never stops on pitch or roll."""
     return 0

@@ -17,6 +17,7 @@ BUILTIN = tuple(import_module(f"{__name__}.{name}") for name in (
     "backstepping",
     "sta",
     "ppc",
+    "los_autopilot",
     "open_loop",
     "open_loop_actuators",
 ))

@@ -9,7 +9,8 @@ The plant state ``xp`` (the plant module's ``NX`` states) and the controller's i
   actuator command and the controller's state derivative are held (zero-order hold) until the
   next sample.  The controller sees the plant's 5-DOF pose plus row k of the seeded noise table.
 
-Logs and metrics always use the true state and the input the plant actually produces.  One row
+Logs and metrics always use the true state and the input the plant actually produces; the
+path-following metrics use the vehicle's navigation point (its origin) against the path.  One row
 is logged every ``log_every`` steps into a preallocated array (O(N) in total).  After every step
 the state is checked; a failure stops the run at once and keeps what was logged.  Every 1024
 steps the loop reads ``info[INFO_STOP]``: a non-zero value (set from another thread, e.g. on
@@ -48,7 +49,7 @@ from ..packing import packed_layout
 from ..plant import contract as plant
 from ..plant.contract import CAUSE_PITCH, CAUSE_ROLL, SCRATCH_SIZE, SF
 from ..reference import eval_reference
-from ..metrics import metrics_update, saturation_update
+from ..metrics import effort_update, metrics_update, path_update, saturation_update
 from ..vehicle.dynamics import nu_dot
 from ..vehicle.kinematics import attitude, virtual_point
 from ..vehicle.params import VP
@@ -377,6 +378,7 @@ def run(pb, cb, env, ref_p, settings, out):
     tau1, tau = np.zeros(3), np.zeros(3)
     aux1, aux = np.zeros(max(naux, 1)), np.zeros(max(naux, 1))
     reuse = state_free_disturbance(env.rows)  # stage 3 may reuse stage 2's reference and omega
+    t_late = 0.5 * (sf[SF.win_t0] + min(sf[SF.win_t1], n_steps * dt))  # second half of the planned window
     row = 0
     info[INFO_STEPS] = 0
     for k in range(n_steps + 1):
@@ -423,6 +425,8 @@ def run(pb, cb, env, ref_p, settings, out):
             break
         metrics_update(acc, t, dt, e, applied, sf[SF.win_t0], sf[SF.win_t1])
         saturation_update(acc, t, dt, sat, sf[SF.win_t0], sf[SF.win_t1])
+        path_update(acc, t, dt, (eta[0], eta[1], eta[2]), ref_p, sf[SF.win_t0], sf[SF.win_t1], t_late)
+        effort_update(acc, t, dt, plant.effort(xp, cmd, pp), sf[SF.win_t0], sf[SF.win_t1])
         for i in range(nxp):
             xps[i] = xp[i] + 0.5 * dt * kp1[i]
         for i in range(nxc):

@@ -101,6 +101,14 @@ def feedback(x, cmd, pp):
     raise NotImplementedError
 
 
+def effort(x, cmd, pp):
+    """(f_u, f_q, f_r): each axis's actuator position now as a fraction of its limit (0 without a limit).
+
+    The actuator-use metrics (``act_*``, ``t_act_limit_*``) accumulate it; 1 means at the limit.
+    """
+    raise NotImplementedError
+
+
 def attitude_cause(x, sf):
     """A plant-specific stop (:data:`CAUSE_PITCH`, :data:`CAUSE_ROLL`) or 0, from the limits in ``sf``."""
     raise NotImplementedError

@@ -92,6 +92,13 @@ def feedback(x, cmd, pp):
     return (-pp[a], -pp[a + 1], -pp[a + 2]), (pp[a], pp[a + 1], pp[a + 2]), (cmd[0], cmd[1], cmd[2])
 
 
+@njit_noalloc(inline="always")
+def effort(x, cmd, pp):
+    """|applied tau_j| / tau_max_j per axis (0 when unlimited: tau_max = inf)."""
+    a = VP.size + ACT_TAU_MAX
+    return abs(cmd[0]) / pp[a], abs(cmd[1]) / pp[a + 1], abs(cmd[2]) / pp[a + 2]
+
+
 @njit_noalloc
 def attitude_cause(x, sf):
     """CAUSE_PITCH when |theta| exceeds ``sf[SF.theta_lim]`` (rad), else 0."""

@@ -20,7 +20,7 @@ from ..fields import Section
 
 __all__ = ["PlantSection", "CompiledPlant", "PlantContext", "PlantSpec", "check_plant", "PLANTS", "register", "get"]
 
-COMPILED = ("pose", "accel5", "allocate", "rhs", "applied", "feedback", "attitude_cause", "log_extra")
+COMPILED = ("pose", "accel5", "allocate", "rhs", "applied", "feedback", "effort", "attitude_cause", "log_extra")
 """The compiled functions of a plant module (:mod:`auvtrack.plant.contract`)."""
 REQUIRED = ("NAME", "STATE", "COMMAND", "LOG_NAMES", "ACCEPTS", "Section", "setup") + COMPILED
 """Every name a plant module defines (``check_scenario`` is optional)."""

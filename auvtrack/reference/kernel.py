@@ -41,8 +41,24 @@ SEG = 1 + 3 * NCOEF
 
 
 @njit_noalloc(inline="always")
-def eval_reference(ref_p, t, out):
-    """Evaluate a packed reference at time ``t``.
+def _axis(ref_p, b, s, harmonic, w, cw, sw):
+    """(position, velocity, acceleration) of one axis whose coefficients start at ``ref_p[b]``."""
+    c0, c1, c2, c3 = ref_p[b], ref_p[b + 1], ref_p[b + 2], ref_p[b + 3]
+    p = c0 + s * (c1 + s * (c2 + s * c3))
+    v = c1 + s * (2.0 * c2 + 3.0 * c3 * s)
+    a = 2.0 * c2 + 6.0 * c3 * s
+    if harmonic:
+        A, B = ref_p[b + 4], ref_p[b + 5]
+        hc = A * cw + B * sw
+        p += hc
+        v += w * (B * cw - A * sw)
+        a -= w * w * hc
+    return p, v, a
+
+
+@njit_noalloc(inline="always")
+def reference_point(ref_p, t):
+    """Position, velocity and acceleration of a packed reference at time ``t``, as tuples.
 
     Parameters
     ----------
@@ -50,9 +66,12 @@ def eval_reference(ref_p, t, out):
         Packed reference (see the module docstring).
     t : float
         Time (s); any finite value is allowed.
-    out : ndarray of float64, shape (3, 3)
-        Written: ``out[0]`` position (m), ``out[1]`` velocity (m/s), ``out[2]`` acceleration
-        (m/s^2), NED.  A malformed pack writes NaN everywhere (never reads out of bounds).
+
+    Returns
+    -------
+    (tuple, tuple, tuple)
+        Position (m), velocity (m/s) and acceleration (m/s^2), NED, 3 floats each.  A malformed
+        pack gives NaN everywhere (never reads out of bounds).
     """
     n = ref_p.shape[0]
     m = 0
@@ -61,10 +80,8 @@ def eval_reference(ref_p, t, out):
         if mf >= 1.0 and mf <= n:  # also rejects NaN
             m = int(mf)
     if m < 1 or HEADER + m * (1 + SEG) > n:
-        for i in range(3):
-            for j in range(3):
-                out[i, j] = math.nan
-        return
+        nan3 = (math.nan, math.nan, math.nan)
+        return nan3, nan3, nan3
     # largest i with T[i] <= t (0 if t < T[0])
     lo = 0
     hi = m - 1
@@ -83,21 +100,30 @@ def eval_reference(ref_p, t, out):
     if harmonic:
         cw = math.cos(w * s)
         sw = math.sin(w * s)
-    for k in range(3):
-        b = r + 1 + NCOEF * k
-        c0, c1, c2, c3 = ref_p[b], ref_p[b + 1], ref_p[b + 2], ref_p[b + 3]
-        p = c0 + s * (c1 + s * (c2 + s * c3))
-        v = c1 + s * (2.0 * c2 + 3.0 * c3 * s)
-        a = 2.0 * c2 + 6.0 * c3 * s
-        if harmonic:
-            A, B = ref_p[b + 4], ref_p[b + 5]
-            hc = A * cw + B * sw
-            p += hc
-            v += w * (B * cw - A * sw)
-            a -= w * w * hc
-        out[0, k] = p
-        out[1, k] = v
-        out[2, k] = a
+    x = _axis(ref_p, r + 1, s, harmonic, w, cw, sw)
+    y = _axis(ref_p, r + 1 + NCOEF, s, harmonic, w, cw, sw)
+    z = _axis(ref_p, r + 1 + 2 * NCOEF, s, harmonic, w, cw, sw)
+    return (x[0], y[0], z[0]), (x[1], y[1], z[1]), (x[2], y[2], z[2])
+
+
+@njit_noalloc(inline="always")
+def eval_reference(ref_p, t, out):
+    """Evaluate a packed reference at time ``t`` into an array (:func:`reference_point`).
+
+    Parameters
+    ----------
+    ref_p : ndarray of float64
+        Packed reference (see the module docstring).
+    t : float
+        Time (s); any finite value is allowed.
+    out : ndarray of float64, shape (3, 3)
+        Written: ``out[0]`` position (m), ``out[1]`` velocity (m/s), ``out[2]`` acceleration
+        (m/s^2), NED.  A malformed pack writes NaN everywhere (never reads out of bounds).
+    """
+    p, v, a = reference_point(ref_p, t)
+    out[0, 0], out[0, 1], out[0, 2] = p
+    out[1, 0], out[1, 1], out[1, 2] = v
+    out[2, 0], out[2, 1], out[2, 2] = a
 
 
 @njit

@@ -46,16 +46,20 @@ def signals(t, e_fn, tau_fn=None):
 
 # ------------------------------------------------------------------ structure
 def test_names_and_size():
-    assert len(METRIC_NAMES) == 33 and len(set(METRIC_NAMES)) == 33
+    assert len(METRIC_NAMES) == 53 and len(set(METRIC_NAMES)) == 53
     for a in "xyz":
         for k in ("rmse", "iae", "itae", "max_abs", "settle_5cm", "settle_1cm", "settle_1mm"):
             assert f"{k}_{a}" in METRIC_NAMES
     for j in "uqr":
-        for k in ("max_abs_tau", "energy_tau", "tv_tau", "t_sat_tau"):
+        for k in ("max_abs_tau", "energy_tau", "tv_tau", "t_sat_tau", "act_rms", "act_max", "act_rate", "t_act_limit"):
             assert f"{k}_{j}" in METRIC_NAMES
+    # the path-following metrics come after the 33 of the virtual point (appended: stored orders unchanged)
+    assert METRIC_NAMES[33:41] == ("xtrack_rmse", "xtrack_max", "vtrack_rmse", "along_rmse", "xtrack_rmse_late",
+                                   "xtrack_max_late", "vtrack_rmse_late", "along_rmse_late")
     acc = np.full(METRICS_SIZE, 7.0)
     metrics_init(acc)
     assert np.all((acc == 0) | np.isnan(acc))
+    assert np.isnan(acc[49])  # the path parameter: none before the first step
 
 
 # ------------------------------------------------------------------ compiled == reference

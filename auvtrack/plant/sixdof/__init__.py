@@ -89,6 +89,14 @@ def feedback(x, cmd, pp):
             (max(a[0], b[0]), max(a[1], b[1]), max(a[2], b[2])), produced(x, dr, ds, n, pp))
 
 
+@njit_noalloc(inline="always")
+def effort(x, cmd, pp):
+    """(|n| / n_max, |delta_s| / delta_max, |delta_r| / delta_max) of the applied actuator states."""
+    dr, ds, n = effective(x, pp)
+    dm = pp[P_DMAX]
+    return abs(n) / pp[P_NMAX], abs(ds) / dm, abs(dr) / dm
+
+
 def setup(section: Section, ctx):
     """Pack the 6-DOF truth of ``section`` (preset, actuator overrides) at the run's initial state.
 
@@ -121,4 +129,4 @@ def setup(section: Section, ctx):
 
 
 __all__ = ["NAME", "STATE", "COMMAND", "LOG_NAMES", "ACCEPTS", "Section", "setup", "check_scenario", "pose", "accel5",
-           "allocate", "rhs", "applied", "feedback", "attitude_cause", "log_extra"]
+           "allocate", "rhs", "applied", "feedback", "effort", "attitude_cause", "log_extra"]
