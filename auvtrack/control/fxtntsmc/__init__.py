@@ -19,10 +19,25 @@ The |z|^(a2-1) of S1_dot (ERRATA 12) is handled by ``surface``: "nonsingular" re
 sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the same device as
 eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
 
-Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels per axis: rho (envelope),
+With ``saturation = "compensated"`` an auxiliary system carries the part of S that the actuators
+could not remove, and the reaching law and the estimator act on the rest (docs/derivation.md
+section 7):
+
+    lam_dot = -k_aux lam + G d_a,   S~ = S - lam                                   (C1)
+    nu      = nu(S~) - k_aux lam,   W_i_dot = G_i psi S~_i - W_i (W_i^T W_i)       (C2)
+
+with d_a = J3 M_bar^-1 (sat(tau) - tau) the error acceleration the actuators' reach removes on the
+nominal model (:mod:`auvtrack.control.saturation`).  Then S~_dot = nu(S~) + G (chi - chi_hat)
+whatever the actuators do, the published closed loop of S~; lam = 0 without saturation, where
+(C1)-(C2) are the published law exactly.  The modified tracking error of Farrell, Polycarpou,
+Sharma & Dong (2009, IEEE TAC 54(6)), with Chen, Ge & Ren's (2011, Automatica 47(3)) auxiliary
+system in its linear form (their extra term for a Lyapunov bound is not used).
+
+Internal state xc = [rho_bar (3), W (3 x m)], then lam (3) when compensated.  Logged aux channels per axis: rho (envelope),
 rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger),
 zeta (z, the transformed error) and gain_ratio (G/Omega: the effective gain G = Omega - c1 with
-which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band).
+which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band); when compensated
+also sat_comp (lam of C1).
 """
 from __future__ import annotations
 
@@ -39,6 +54,7 @@ from . import envelopes
 from . import rbf
 from ..registry import CompiledController, ControllerParams
 from ..contract import WORK_SIZE
+from ..saturation import COMPENSATED, SATURATION, accel_deficit, code
 from ..tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "fxtntsmc"
@@ -48,16 +64,19 @@ AUX = packed_layout("FXTNTSMCChannels", rho=3, rho1=3, chi_hat=3, sliding=3, g=3
 """Logged channels per axis: envelope rho and its baseline rho1, the estimate chi_hat, the sliding
 variable S, the risk indicator g, the transformed error zeta (eq. 17) and G/Omega."""
 AUX_NAMES = tuple(f"{n}_{a}" for n in AUX.names for a in AXES)
+COMPENSATION_NAMES = tuple(f"sat_comp_{a}" for a in AXES)
+"""Channels added when compensated: lam of (C1)."""
 
 GAINS = packed_layout("FXTNTSMCParams", kappa1=1, kappa2=1, kappa3=1, a1=1, a2=1, a3=1, a4=1, alpha=1, sigma=1,
                       surface=1, z_switch=1, z_floor=1, envelope=1, envelope_params=envelopes.PARAMS.size,
-                      c1=1, c2=1, beta1=1, beta2=1, estimator=1, neurons=1, width=1, centres=None)
+                      c1=1, c2=1, beta1=1, beta2=1, estimator=1, neurons=1, width=1, k_aux=1, saturation=1,
+                      centres=None)
 """Packed parameters (:func:`setup`): the gains, the envelope kind and its parameters
 (:func:`envelopes.axis_transform`), constants precomputed from the gains (c1, c2 of the
 nonsingular quadratic, :func:`surface_coeffs`; beta1, beta2 of eq. 27, :func:`switch_coeffs`), the
-estimator, and the 6 m RBF centres."""
+estimator, the saturation form with its k_aux, and the 6 m RBF centres."""
 STATE = packed_layout("FXTNTSMCState", rho_bar=3, weights=None)
-"""Internal state xc: the envelope filters rho_bar (3), then the RBF weights W (3 m)."""
+"""Internal state xc: the envelope filters rho_bar (3), then the RBF weights W (3 m), then lam (3) when compensated."""
 SURFACES = {"nonsingular": 0, "printed": 1}
 MAX_NEURONS = WORK_SIZE  # the basis psi occupies work[0:m]
 
@@ -87,6 +106,11 @@ class Params(ControllerParams):
     )
     z_switch: float = Field(0.01, gt=0, description="|z| below which the nonsingular switch is used")
     z_floor: float = Field(1e-6, gt=0, description="floor on |z| in the printed form's |z|^(a2-1)")
+    k_aux: float = Field(1.0, gt=0, description="decay rate of the auxiliary system (C1), 1/s (saturation = "
+                         "'compensated')")
+    saturation: Literal[SATURATION] = Field(
+        "published", description="'published': eq. (26)-(34); 'compensated': reaching law and estimator on S "
+        "less the auxiliary system's response to what the actuators could not produce (C1)-(C2)")
 
 
 
@@ -237,23 +261,26 @@ def _transform(kind, shape, cp, eprm, e, ed, xc, i):
 
 
 @njit_noalloc(inline="always")
-def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux):
+def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux, lam, kl):
     """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27) and the commanded e_ddot (eq. 32, ERRATA 13).
 
-    Returns (S (m/s), e_ddot (m/s^2), Omega_i, G_i), G_i = Omega_i - c1_i the effective gain with
-    which chi enters S_dot (1/m, as Omega); writes dxc of rho_bar_i and the aux channels except
-    chi_hat, which the estimator's update of the three axes fills in afterwards.
+    ``lam`` and ``kl`` are lam_i and k_aux of (C1)-(C2) (both 0 in the published form, where the
+    arithmetic is the published law's: S - 0 = S and nu - 0 = nu exactly).  Returns (S~ = S -
+    lam (m/s), e_ddot (m/s^2), Omega_i, G_i), G_i = Omega_i - c1_i the effective gain with which
+    chi enters S_dot (1/m, as Omega); writes dxc of rho_bar_i and the aux channels except chi_hat,
+    which the estimator's update of the three axes fills in afterwards.
     """
     _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
     s1, dphi = switch_q(se, cp[GAINS.alpha], cp[GAINS.sigma], cp[GAINS.beta1], cp[GAINS.beta2], qs)
     S = zd + s1
-    reach = reaching_law(S, cp[GAINS.kappa1], cp[GAINS.kappa2], cp[GAINS.kappa3])
+    St = S - lam
+    reach = reaching_law(St, cp[GAINS.kappa1], cp[GAINS.kappa2], cp[GAINS.kappa3]) - kl * lam
     G = Om - c1  # > 0 (docs/derivation.md section 3)
     edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / G
     dxc[STATE.rho_bar + i] = rbd
     aux[AUX.rho + i], aux[AUX.rho1 + i], aux[AUX.sliding + i], aux[AUX.g + i], aux[AUX.zeta + i] = rho, rho1, S, g, z
     aux[AUX.gain_ratio + i] = G / Om  # exactly 1 where c1 = 0
-    return S, edd, Om, G
+    return St, edd, Om, G
 
 
 @njit_noalloc(inline="always")
@@ -298,9 +325,13 @@ def control(t, y, xc, args, out):
     se2, dse2 = surface_q(z[2], cp[GAINS.a1], cp[GAINS.a2], cp[GAINS.a3], cp[GAINS.a4], printed, cp[GAINS.z_switch], cp[GAINS.z_floor], cp[GAINS.c1], cp[GAINS.c2], qz[2])
     ase = (abs(se0), abs(se1), abs(se2))
     qs = powers_below3(ase, cp[GAINS.alpha], (ase[0] > cp[GAINS.sigma], ase[1] > cp[GAINS.sigma], ase[2] > cp[GAINS.sigma]))
-    S0, edd0, om0, G0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux)
-    S1, edd1, om1, G1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux)
-    S2, edd2, om2, G2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux)
+    comp = cp[GAINS.saturation] == COMPENSATED
+    off = STATE.weights + 3 * m  # lam of (C1), when compensated
+    lam = (xc[off], xc[off + 1], xc[off + 2]) if comp else (0.0, 0.0, 0.0)
+    kl = cp[GAINS.k_aux] if comp else 0.0
+    S0, edd0, om0, G0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux, lam[0], kl)
+    S1, edd1, om1, G1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux, lam[1], kl)
+    S2, edd2, om2, G2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux, lam[2], kl)
     chat = (0.0, 0.0, 0.0)
     if est != rbf.NONE:
         gain = (1.0, 1.0, 1.0)  # printed eq. (34)
@@ -311,7 +342,13 @@ def control(t, y, xc, args, out):
         chat = rbf.estimate_and_adapt3(xc, STATE.weights, m, work, (S0, S1, S2), gain, dxc)
     aux[AUX.chi_hat], aux[AUX.chi_hat + 1], aux[AUX.chi_hat + 2] = chat
     acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])
-    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, acc, gf)
+    tau = input_for_accel_forces(y.att, args.vp, f, acc, gf)
+    out.u[0], out.u[1], out.u[2] = tau
+    if comp:  # (C1)
+        da = accel_deficit(y.att, args.vp, tau, args.lo, args.hi)[0]
+        dxc[off], dxc[off + 1], dxc[off + 2] = (-kl * lam[0] + G0 * da[0], -kl * lam[1] + G1 * da[1],
+                                                -kl * lam[2] + G2 * da[2])
+        aux[AUX.size], aux[AUX.size + 1], aux[AUX.size + 2] = lam
     return 0
 
 
@@ -366,11 +403,15 @@ def setup(params: Params, ctx) -> CompiledController:
                         lambda3=env.lambda3, threshold=env.reactive_threshold, printed=float(printed), rho0=rho0,
                         rho_inf=rho_inf),
                     c1=c1, c2=c2, beta1=beta1, beta2=beta2,
-                    estimator=rbf.ESTIMATORS[est.kind], neurons=m, width=est.width, centres=centres.ravel())
+                    estimator=rbf.ESTIMATORS[est.kind], neurons=m, width=est.width, k_aux=p.k_aux,
+                    saturation=code(p.saturation), centres=centres.ravel())
     xc0 = STATE.pack(rho_bar=rb0, weights=weights.ravel())
+    comp = p.saturation == "compensated"
+    if comp:
+        xc0 = np.concatenate([xc0, np.zeros(3)])  # lam(0) = 0
     resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
-    return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),
-                              resolved=resolved)
+    return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES + (COMPENSATION_NAMES if comp else ()),
+                              notes=tuple(notes), resolved=resolved)
 
 
 def warnings(params: Params) -> list[str]:
