@@ -19,21 +19,25 @@ The |z|^(a2-1) of S1_dot (ERRATA 12) is handled by ``surface``: "nonsingular" re
 sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the same device as
 eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
 
-With ``saturation = "compensated"`` an auxiliary system carries the part of S that the actuators
-could not remove, and the reaching law and the estimator act on the rest (docs/derivation.md
-section 7):
+With ``saturation = "compensated"`` an auxiliary system carries the part of the error that the
+actuators could not remove, and the whole law (envelope, surface, reaching law, estimator) acts on
+the rest, the compensated error e~ (docs/derivation.md section 7):
 
-    lam_dot = -k_aux lam + G d_a,   S~ = S - lam                                   (C1)
-    nu      = nu(S~) - k_aux lam,   W_i_dot = G_i psi S~_i - W_i (W_i^T W_i)       (C2)
+    lam_ddot = -2 k_aux lam_dot - k_aux^2 lam + d_a,   e~ = e - lam                 (C1)
+    a        = e_ddot*(e~, e~_dot) - chi_hat - 2 k_aux lam_dot - k_aux^2 lam          (C2)
 
 with d_a = J3 M_bar^-1 (sat(tau) - tau) the error acceleration the actuators' reach removes on the
-nominal model (:mod:`auvtrack.control.saturation`).  Then S~_dot = nu(S~) + G (chi - chi_hat)
-whatever the actuators do, the published closed loop of S~; lam = 0 without saturation, where
-(C1)-(C2) are the published law exactly.  The modified tracking error of Farrell, Polycarpou,
-Sharma & Dong (2009, IEEE TAC 54(6)), with Chen, Ge & Ren's (2011, Automatica 47(3)) auxiliary
-system in its linear form (their extra term for a Lyapunov bound is not used).
+nominal model (:mod:`auvtrack.control.saturation`) and e_ddot*, chi_hat the published law's
+(eq. 26-34) evaluated at e~.  Then e~_ddot = e_ddot*(e~) - chi_hat + chi whatever the actuators do:
+S of e~ obeys the published S_dot = nu + G (chi - chi_hat), and the estimator adapts on it, not on
+the error the saturation caused; lam = 0 without saturation, where (C1)-(C2) are the published law
+exactly.  The modified tracking error of Farrell, Polycarpou, Sharma & Dong (2009, IEEE TAC 54(6)),
+with an auxiliary system driven by the input deficit as in Chen, Ge & Ren (2011, Automatica 47(3))
+in its linear form (their extra term for a Lyapunov bound is not used).  The same auxiliary
+system as the PPC's (R5)-(R6).
 
-Internal state xc = [rho_bar (3), W (3 x m)], then lam (3) when compensated.  Logged aux channels per axis: rho (envelope),
+Internal state xc = [rho_bar (3), W (3 x m)], then lam (3, m) and lam_dot (3, m/s) when compensated.
+Logged aux channels per axis: rho (envelope),
 rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger),
 zeta (z, the transformed error) and gain_ratio (G/Omega: the effective gain G = Omega - c1 with
 which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band); when compensated
@@ -76,7 +80,7 @@ GAINS = packed_layout("FXTNTSMCParams", kappa1=1, kappa2=1, kappa3=1, a1=1, a2=1
 nonsingular quadratic, :func:`surface_coeffs`; beta1, beta2 of eq. 27, :func:`switch_coeffs`), the
 estimator, the saturation form with its k_aux, and the 6 m RBF centres."""
 STATE = packed_layout("FXTNTSMCState", rho_bar=3, weights=None)
-"""Internal state xc: the envelope filters rho_bar (3), then the RBF weights W (3 m), then lam (3) when compensated."""
+"""Internal state xc: the envelope filters rho_bar (3), then the RBF weights W (3 m), then (lam, lam_dot) (6) when compensated."""
 SURFACES = {"nonsingular": 0, "printed": 1}
 MAX_NEURONS = WORK_SIZE  # the basis psi occupies work[0:m]
 
@@ -106,11 +110,10 @@ class Params(ControllerParams):
     )
     z_switch: float = Field(0.01, gt=0, description="|z| below which the nonsingular switch is used")
     z_floor: float = Field(1e-6, gt=0, description="floor on |z| in the printed form's |z|^(a2-1)")
-    k_aux: float = Field(1.0, gt=0, description="decay rate of the auxiliary system (C1), 1/s (saturation = "
-                         "'compensated')")
+    k_aux: float = Field(1.0, gt=0, description="rate of the auxiliary system (C1), 1/s (saturation = 'compensated')")
     saturation: Literal[SATURATION] = Field(
-        "published", description="'published': eq. (26)-(34); 'compensated': reaching law and estimator on S "
-        "less the auxiliary system's response to what the actuators could not produce (C1)-(C2)")
+        "published", description="'published': eq. (26)-(34); 'compensated': the law on the error less the "
+        "auxiliary system's response to what the actuators could not produce (C1)-(C2)")
 
 
 
@@ -261,26 +264,23 @@ def _transform(kind, shape, cp, eprm, e, ed, xc, i):
 
 
 @njit_noalloc(inline="always")
-def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux, lam, kl):
+def _finish_axis(i, tr, z, se, dse, qs, ed_i, cp, dxc, aux):
     """Axis ``i`` after its S_e (eq. 28): S (eq. 26-27) and the commanded e_ddot (eq. 32, ERRATA 13).
 
-    ``lam`` and ``kl`` are lam_i and k_aux of (C1)-(C2) (both 0 in the published form, where the
-    arithmetic is the published law's: S - 0 = S and nu - 0 = nu exactly).  Returns (S~ = S -
-    lam (m/s), e_ddot (m/s^2), Omega_i, G_i), G_i = Omega_i - c1_i the effective gain with which
-    chi enters S_dot (1/m, as Omega); writes dxc of rho_bar_i and the aux channels except chi_hat,
-    which the estimator's update of the three axes fills in afterwards.
+    Returns (S (m/s), e_ddot (m/s^2), Omega_i, G_i), G_i = Omega_i - c1_i the effective gain with
+    which chi enters S_dot (1/m, as Omega); writes dxc of rho_bar_i and the aux channels except
+    chi_hat, which the estimator's update of the three axes fills in afterwards.
     """
     _, zd, Om, U, Omd, c0, c1, rho, rbd, rho1, g = tr
     s1, dphi = switch_q(se, cp[GAINS.alpha], cp[GAINS.sigma], cp[GAINS.beta1], cp[GAINS.beta2], qs)
     S = zd + s1
-    St = S - lam
-    reach = reaching_law(St, cp[GAINS.kappa1], cp[GAINS.kappa2], cp[GAINS.kappa3]) - kl * lam
+    reach = reaching_law(S, cp[GAINS.kappa1], cp[GAINS.kappa2], cp[GAINS.kappa3])
     G = Om - c1  # > 0 (docs/derivation.md section 3)
     edd = (reach - dphi * dse * zd - Omd * ed_i + c0 + U * ed_i) / G
     dxc[STATE.rho_bar + i] = rbd
     aux[AUX.rho + i], aux[AUX.rho1 + i], aux[AUX.sliding + i], aux[AUX.g + i], aux[AUX.zeta + i] = rho, rho1, S, g, z
     aux[AUX.gain_ratio + i] = G / Om  # exactly 1 where c1 = 0
-    return St, edd, Om, G
+    return S, edd, Om, G
 
 
 @njit_noalloc(inline="always")
@@ -292,6 +292,11 @@ def control(t, y, xc, args, out):
     cp, work, dxc, aux = args.cp, args.work, out.dxc, out.aux
     e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
     kind, est, m = int(cp[GAINS.envelope]), int(cp[GAINS.estimator]), int(cp[GAINS.neurons])
+    comp = cp[GAINS.saturation] == COMPENSATED
+    off = STATE.weights + 3 * m  # (lam, lam_dot) of (C1), when compensated
+    if comp:  # the law acts on e~ = e - lam (C2)
+        e = (e[0] - xc[off], e[1] - xc[off + 1], e[2] - xc[off + 2])
+        ed = (ed[0] - xc[off + 3], ed[1] - xc[off + 4], ed[2] - xc[off + 5])
     if est != rbf.NONE:
         rbf.basis(e, ed, cp, GAINS.centres, m, cp[GAINS.width], work)
     printed = cp[GAINS.surface] != 0.0
@@ -325,13 +330,9 @@ def control(t, y, xc, args, out):
     se2, dse2 = surface_q(z[2], cp[GAINS.a1], cp[GAINS.a2], cp[GAINS.a3], cp[GAINS.a4], printed, cp[GAINS.z_switch], cp[GAINS.z_floor], cp[GAINS.c1], cp[GAINS.c2], qz[2])
     ase = (abs(se0), abs(se1), abs(se2))
     qs = powers_below3(ase, cp[GAINS.alpha], (ase[0] > cp[GAINS.sigma], ase[1] > cp[GAINS.sigma], ase[2] > cp[GAINS.sigma]))
-    comp = cp[GAINS.saturation] == COMPENSATED
-    off = STATE.weights + 3 * m  # lam of (C1), when compensated
-    lam = (xc[off], xc[off + 1], xc[off + 2]) if comp else (0.0, 0.0, 0.0)
-    kl = cp[GAINS.k_aux] if comp else 0.0
-    S0, edd0, om0, G0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux, lam[0], kl)
-    S1, edd1, om1, G1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux, lam[1], kl)
-    S2, edd2, om2, G2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux, lam[2], kl)
+    S0, edd0, om0, G0 = _finish_axis(0, tr0, z[0], se0, dse0, qs[0], ed[0], cp, dxc, aux)
+    S1, edd1, om1, G1 = _finish_axis(1, tr1, z[1], se1, dse1, qs[1], ed[1], cp, dxc, aux)
+    S2, edd2, om2, G2 = _finish_axis(2, tr2, z[2], se2, dse2, qs[2], ed[2], cp, dxc, aux)
     chat = (0.0, 0.0, 0.0)
     if est != rbf.NONE:
         gain = (1.0, 1.0, 1.0)  # printed eq. (34)
@@ -342,13 +343,18 @@ def control(t, y, xc, args, out):
         chat = rbf.estimate_and_adapt3(xc, STATE.weights, m, work, (S0, S1, S2), gain, dxc)
     aux[AUX.chi_hat], aux[AUX.chi_hat + 1], aux[AUX.chi_hat + 2] = chat
     acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])
-    tau = input_for_accel_forces(y.att, args.vp, f, acc, gf)
+    if not comp:
+        out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, acc, gf)
+        return 0
+    k = cp[GAINS.k_aux]
+    b0, b1, b2 = (-2.0 * k * xc[off + 3] - k * k * xc[off], -2.0 * k * xc[off + 4] - k * k * xc[off + 1],
+                  -2.0 * k * xc[off + 5] - k * k * xc[off + 2])  # the auxiliary system's own part of (C1)
+    tau = input_for_accel_forces(y.att, args.vp, f, (acc[0] + b0, acc[1] + b1, acc[2] + b2), gf)
     out.u[0], out.u[1], out.u[2] = tau
-    if comp:  # (C1)
-        da = accel_deficit(y.att, args.vp, tau, args.lo, args.hi)[0]
-        dxc[off], dxc[off + 1], dxc[off + 2] = (-kl * lam[0] + G0 * da[0], -kl * lam[1] + G1 * da[1],
-                                                -kl * lam[2] + G2 * da[2])
-        aux[AUX.size], aux[AUX.size + 1], aux[AUX.size + 2] = lam
+    da = accel_deficit(y.att, args.vp, tau, args.lo, args.hi)[0]
+    dxc[off], dxc[off + 1], dxc[off + 2] = xc[off + 3], xc[off + 4], xc[off + 5]
+    dxc[off + 3], dxc[off + 4], dxc[off + 5] = b0 + da[0], b1 + da[1], b2 + da[2]
+    aux[AUX.size], aux[AUX.size + 1], aux[AUX.size + 2] = xc[off], xc[off + 1], xc[off + 2]
     return 0
 
 
@@ -408,7 +414,7 @@ def setup(params: Params, ctx) -> CompiledController:
     xc0 = STATE.pack(rho_bar=rb0, weights=weights.ravel())
     comp = p.saturation == "compensated"
     if comp:
-        xc0 = np.concatenate([xc0, np.zeros(3)])  # lam(0) = 0
+        xc0 = np.concatenate([xc0, np.zeros(6)])  # lam(0) = lam_dot(0) = 0
     resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
     return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES + (COMPENSATION_NAMES if comp else ()),
                               notes=tuple(notes), resolved=resolved)
