@@ -19,10 +19,23 @@ over three references at a REMUS speed and turn radius both truths can fly (1.25
 the model gap is the disturbance.  The vehicle starts 0.5 m beside the reference's start at the
 reference speed, its propeller trimmed (:func:`auvtrack.plant.sixdof.truth.trim_rpm`).
 
+Every controller flies each case twice (``gains``):
+
+=============  ===================================================================
+``designed``   the defaults on the ``remus100`` design vehicle: gains designed for its actuators'
+               reach and ``saturation = "compensated"`` (docs/controllers.md, "Gains designed for
+               the vehicle"; :mod:`auvtrack.control.design`)
+``published``  the law's fixed default gains (Section 4's) and its published form
+               (``saturation = "published"``; the PID without back-calculation)
+=============  ===================================================================
+
 Reported per run: status and failure cause (pitch, roll, envelope, divergence, ...), steady-state
-tracking error (RMSE and max |e| over the second half), and actuator usage: the time each
-actuator sits at its limit (fins at delta_max, propeller at n_max) and the fins' rate
-(RMS and max |d delta / dt| from the log).  ``--quick`` runs the helix without current for 20 s.
+tracking error (RMSE and max |e| over the second half), the horizontal distance of the vehicle's
+origin (its navigation point) to the reference path (RMS over the run and over its second half,
+max; :func:`path_distance`, until the engine's path-following metric ``xtrack_rmse`` is
+available), and actuator usage: the time each actuator sits at its limit (fins at delta_max,
+propeller at n_max) and the fins' rate (RMS and max |d delta / dt| from the log).  ``--quick``
+runs the helix without current for 20 s.
 """
 from __future__ import annotations
 
@@ -51,6 +64,8 @@ REFERENCES = {
                                                   [110.0, 90.0, 6.0], [60.0, 120.0, 4.0]], "speed": SPEED},
 }
 ELL = 1.0  # m, virtual-point offset (remus100 preset)
+GAINS = ("designed", "published")
+"""The two gain sets every controller flies (module docstring)."""
 
 
 def controllers() -> list[str]:
@@ -72,17 +87,29 @@ def start_pose(ref_spec: dict, ell: float = ELL) -> tuple[list[float], list[floa
     return eta, [speed, 0.0, 0.0, 0.0, 0.0]
 
 
-def scenario(controller: str, truth: str, reference: str, current: bool, duration: float) -> dict:
-    """The scenario (a dict for :func:`auvtrack.scenario.load_scenario`) of one run."""
+def controller_section(controller: str, gains: str = "designed") -> dict:
+    """The ``[controller]`` of a gain set of :data:`GAINS`: the kind only (designed on the remus100), or
+    the law's fixed defaults in its published form."""
+    from ..control import CONTROLLERS
+
+    if gains == "designed":
+        return {"kind": controller}
+    published = {"saturation": "published"} if "saturation" in CONTROLLERS[controller].params.model_fields else {}
+    return {"kind": controller, "preset": "defaults", **published}
+
+
+def scenario(controller: str, truth: str, reference: str, current: bool, duration: float,
+             gains: str = "designed") -> dict:
+    """The scenario (a dict for :func:`auvtrack.scenario.load_scenario`) of one run (``gains``: one of :data:`GAINS`)."""
     ref = REFERENCES[reference]
     eta, nu = start_pose(ref)
     sc = {
-        "name": f"model-gap-{controller}-{truth}-{reference}-{'current' if current else 'calm'}",
+        "name": f"model-gap-{controller}-{gains}-{truth}-{reference}-{'current' if current else 'calm'}",
         "sim": {"duration": duration, "dt": 0.001, "log_dt": 0.01},
         "vehicle": {"preset": "remus100", "l": ELL},
         "reference": ref,
         "initial": {"eta": eta, "nu": nu},
-        "controller": {"kind": controller},
+        "controller": controller_section(controller, gains),
         "disturbance": [CURRENT] if current else [],
         "metrics": {"window": [duration / 2, duration]},
     }
@@ -94,10 +121,34 @@ def scenario(controller: str, truth: str, reference: str, current: bool, duratio
 
 
 def jobs(quick: bool) -> list[tuple]:
-    """Every (controller, truth, reference, current) of the study."""
+    """Every (controller, truth, reference, current, gains) of the study."""
     refs = ("helix",) if quick else tuple(REFERENCES)
     currents = (False,) if quick else (False, True)
-    return [(k, t, r, c) for k in controllers() for t in TRUTHS for r in refs for c in currents]
+    return [(k, t, r, c, g) for k in controllers() for g in GAINS for t in TRUTHS for r in refs for c in currents]
+
+
+def path_distance(res) -> np.ndarray:
+    """Horizontal distance (m) of the vehicle's origin to the reference path at every logged sample.
+
+    The path is the reference's horizontal track as logged (``xd``, ``yd`` at every sample, the
+    virtual point's reference); the distance is to its nearest logged point (a k-d tree), so it
+    is exact to within half the logged spacing (1.25 cm at 1.25 m/s and 0.01 s).  At the start the
+    origin sits ell behind the path's first point, so the first samples measure that offset.
+
+    Parameters
+    ----------
+    res : auvtrack.simulation.result.Result
+        A run with ``x``, ``y``, ``xd``, ``yd`` logged.
+
+    Returns
+    -------
+    numpy.ndarray
+        One distance per logged sample.
+    """
+    from scipy.spatial import cKDTree
+
+    ch = res.channels
+    return cKDTree(np.c_[ch["xd"], ch["yd"]]).query(np.c_[ch["x"], ch["y"]])[0]
 
 
 def _at_limit(x: np.ndarray, limit: float) -> np.ndarray:
@@ -105,21 +156,26 @@ def _at_limit(x: np.ndarray, limit: float) -> np.ndarray:
 
 
 def summarise(job: tuple, res, limits: dict | None) -> dict:
-    """One result row: status, cause, tracking error, actuator usage."""
-    kind, truth, ref, current = job
+    """One result row: status, cause, tracking error, distance to the path, actuator usage."""
+    kind, truth, ref, current, gains = job
     ch = res.channels
     t = ch["t"]
     T = t[-1] if t.size else 0.0
-    row = {"controller": kind, "truth": truth, "reference": ref, "current": current, "status": res.status,
-           "cause": failure_cause(res), "fail_time": res.failure["time"] if res.failure else None}
+    row = {"controller": kind, "gains": gains, "truth": truth, "reference": ref, "current": current,
+           "status": res.status, "cause": failure_cause(res), "fail_time": res.failure["time"] if res.failure else None}
     if t.size == 0:  # stopped before the first logged row
-        row.update(rmse_late=None, max_e_late=None, max_theta_deg=None)
+        row.update(rmse_late=None, max_e_late=None, max_theta_deg=None, path_rmse=None, path_rmse_late=None,
+                   path_max=None)
         row["duration_run"] = 0.0
         return row
     e = np.sqrt(ch["ex"] ** 2 + ch["ey"] ** 2 + ch["ez"] ** 2)
     late = t >= t[-1] / 2
     row["rmse_late"] = float(np.sqrt(np.mean(e[late] ** 2)))
     row["max_e_late"] = float(e[late].max())
+    d = path_distance(res)
+    row["path_rmse"] = float(np.sqrt(np.mean(d ** 2)))
+    row["path_rmse_late"] = float(np.sqrt(np.mean(d[late] ** 2)))
+    row["path_max"] = float(d.max())
     row["max_theta_deg"] = float(np.degrees(np.abs(ch["theta"]).max()))
     if limits is not None and "delta_r" in ch:
         dt = np.diff(t)
@@ -164,9 +220,11 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     duration = 20.0 if quick else 150.0
     rows = []
     for job in tqdm(jobs(quick), disable=not progress, desc="model-gap"):
-        sc = load_scenario(scenario(*job, duration))
+        kind, truth, ref, current, gains = job
+        sc = load_scenario(scenario(kind, truth, ref, current, duration, gains))
         res = run_prepared(prepare(sc))
-        rows.append(summarise(job, res, sc.plant.actuator_limits()))
+        limits = sc.plant.actuator_limits() if hasattr(sc.plant, "actuator_limits") else None  # 6-DOF truths only
+        rows.append(summarise(job, res, limits))
     write_json(out / "results.json", {"duration_s": duration, "quick": quick, "rows": rows,
                                       "references": {k: REFERENCES[k] for k in {r["reference"] for r in rows}},
                                       "current": CURRENT})
@@ -175,19 +233,23 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     rep.paragraph(
         f"Design model: `remus100` (5-DOF, reduced at the reference's speed). Truths: its own 5-DOF model "
         f"(no uncertainty), `remus100_prestero`, `remus100_fossen` (6-DOF, fins and propeller through the "
-        f"control allocation). {duration:g} s runs; errors and the time with tau unproducible (the "
-        f"allocation's saturation flags) over the second half; fins / rpm at limit and fin rates over the "
-        f"whole run (fractions of the logged samples). Current: "
+        f"control allocation). Gains: `designed` (the defaults on this vehicle: designed for its actuators' "
+        f"reach, compensated form) and `published` (the law's fixed defaults, published form). {duration:g} s "
+        f"runs; errors and the time with tau unproducible (the allocation's saturation flags) over the second "
+        f"half; distance of the vehicle's origin to the path (its horizontal track) over the run and its second "
+        f"half; fins / rpm at limit and fin rates over the whole run (fractions of the logged samples). Current: "
         f"Gauss-Markov, mean {CURRENT['mean']} m/s, sigma {CURRENT['sigma']} m/s.")
     rep.heading("Failures by cause")
-    rep.table(["controller", "truth", "runs", "failed", "causes"], _failure_table(rows))
+    rep.table(["controller", "gains", "truth", "runs", "failed", "causes"], _failure_table(rows))
     rep.heading("Runs")
-    rep.table(["controller", "truth", "reference", "current", "status", "rmse late (m)", "max \\|e\\| late (m)",
+    rep.table(["controller", "gains", "truth", "reference", "current", "status", "rmse late (m)",
+               "max \\|e\\| late (m)", "path rms / late (m)",
                "max \\|theta\\| (deg)", "max \\|phi\\| (deg)", "tau unproducible u / q / r (s)", "fins at limit (r / s)",
                "rpm at limit", "fin rate rms r / s (rad/s)"],
-              [[r["controller"], r["truth"], r["reference"], "yes" if r["current"] else "no",
+              [[r["controller"], r.get("gains", "designed"), r["truth"], r["reference"], "yes" if r["current"] else "no",
                 "ok" if r["status"] == "ok" else f"failed: {r['cause']} at {r['fail_time']:.3g} s",
-                r["rmse_late"], r["max_e_late"], r["max_theta_deg"], r.get("max_phi_deg"),
+                r["rmse_late"], r["max_e_late"], _pair(r.get("path_rmse"), r.get("path_rmse_late")),
+                r["max_theta_deg"], r.get("max_phi_deg"),
                 " / ".join("–" if r.get(f"t_sat_tau_{j}") is None else f"{r[f't_sat_tau_{j}']:.3g}" for j in "uqr"),
                 _pair(r.get("sat_frac_delta_r"), r.get("sat_frac_delta_s")), r.get("sat_frac_rpm"),
                 _pair(r.get("rate_rms_delta_r"), r.get("rate_rms_delta_s"))] for r in rows], digits=3)
@@ -201,11 +263,15 @@ def _pair(a, b) -> str:
 def _failure_table(rows: list[dict]) -> list[list]:
     out = []
     for kind in dict.fromkeys(r["controller"] for r in rows):
-        for truth in TRUTHS:
-            mine = [r for r in rows if r["controller"] == kind and r["truth"] == truth]
-            causes = Counter(r["cause"] for r in mine if r["status"] != "ok")
-            out.append([kind, truth, len(mine), sum(causes.values()),
-                        ", ".join(f"{c} × {n}" for c, n in sorted(causes.items())) or "–"])
+        for gains in GAINS:
+            for truth in TRUTHS:
+                mine = [r for r in rows if r["controller"] == kind and r.get("gains", "designed") == gains
+                        and r["truth"] == truth]
+                if not mine:
+                    continue
+                causes = Counter(r["cause"] for r in mine if r["status"] != "ok")
+                out.append([kind, gains, truth, len(mine), sum(causes.values()),
+                            ", ".join(f"{c} × {n}" for c, n in sorted(causes.items())) or "–"])
     return out
 
 
@@ -219,4 +285,5 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
 
 
 STUDY = StudySpec("model-gap", run, "controllers designed on the 5-DOF REMUS 100 flown on 6-DOF truth "
-                  "models (Prestero, Fossen): failures by cause, tracking, actuator usage")
+                  "models (Prestero, Fossen), designed and published gains: failures by cause, tracking, "
+                  "distance to the path, actuator usage")

@@ -101,7 +101,7 @@ def test_stored_results_come_from_the_current_study_definitions():
     assert rp["steady_window"]["window"] == [50.0, 100.0]  # the full run, not --quick
     mg = findings.load("model-gap")
     assert mg["quick"] is False and mg["duration_s"] == 150.0
-    assert sorted((r["controller"], r["truth"], r["reference"], r["current"]) for r in mg["rows"]) == \
+    assert sorted((r["controller"], r["truth"], r["reference"], r["current"], r["gains"]) for r in mg["rows"]) == \
         sorted(model_gap.jobs(False))
     assert mg["references"] == _jsonish(model_gap.REFERENCES) and mg["current"] == _jsonish(model_gap.CURRENT)
     for name in findings.SOURCES:
