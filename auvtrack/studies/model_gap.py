@@ -88,8 +88,21 @@ def start_pose(ref_spec: dict, ell: float = ELL) -> tuple[list[float], list[floa
 
 
 def controller_section(controller: str, gains: str = "designed") -> dict:
-    """The ``[controller]`` of a gain set of :data:`GAINS`: the kind only (designed on the remus100), or
-    the law's fixed defaults in its published form."""
+    """The ``[controller]`` section of one gain set of :data:`GAINS`.
+
+    Parameters
+    ----------
+    controller : str
+        ``controller.kind``.
+    gains : str
+        ``"designed"``: the kind only (the defaults on the remus100: designed gains, compensated
+        form); ``"published"``: the law's fixed defaults in its published form.
+
+    Returns
+    -------
+    dict
+        The section.
+    """
     from ..control import CONTROLLERS
 
     if gains == "designed":

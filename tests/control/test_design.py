@@ -179,3 +179,12 @@ def test_the_studies_that_keep_stored_results_pin_the_defaults():
     assert load_scenario(robustness.sample_scenario(s, "remus100", "ftsmc", None, 2.0, 0.002)).controller == ftsmc.Params()
     prep = realism._prepare(("remus100", "ftsmc", "sampling", 100.0, ["sim.duration=0.1"]))
     assert prep.scenario.controller == ftsmc.Params()
+
+
+def test_generated_design_table_in_docs_controllers_md_is_current():
+    from tools import gain_design
+
+    text = gain_design.DOC.read_text()
+    names = [m.group("name") for m in gain_design.BLOCK_RE.finditer(text) if m.group("name") in gain_design.blocks()]
+    assert names == ["gain-design"]
+    assert gain_design.render_text(text) == text, "stale: python -m tools.gain_design render"
