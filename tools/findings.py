@@ -332,11 +332,17 @@ def _ref_speed(spec: dict) -> float:
     return float(spec["speed"]) if "speed" in spec else float(spec["omega"]) * float(spec["radius"])
 
 
+def model_gap_label(row: dict) -> str:
+    """A model-gap row's controller with its gain set (``pid (designed)``), or the controller alone in
+    results stored before the study flew two gain sets."""
+    return row["controller"] + (f" ({row['gains']})" if "gains" in row else "")
+
+
 def model_gap_tally(mg: dict) -> dict[str, dict[str, list[int]]]:
-    """Controller -> truth -> [failed, runs] of the model-gap study."""
+    """Controller (with its gain set) -> truth -> [failed, runs] of the model-gap study."""
     out: dict[str, dict[str, list[int]]] = {}
     for r in mg["rows"]:
-        c = out.setdefault(r["controller"], {}).setdefault(r["truth"], [0, 0])
+        c = out.setdefault(model_gap_label(r), {}).setdefault(r["truth"], [0, 0])
         c[0] += r["status"] != "ok"
         c[1] += 1
     return out
@@ -353,8 +359,11 @@ def block_model_gap(mg: dict) -> str:
                                       else "with ")
         + (f"a Gauss–Markov current (mean {cur['mean']} m/s NED, σ {cur['sigma']} m/s, τ {_f(cur['tau'])} s)"
            if True in currents else "")
-        + "; every built-in tracking controller with its package defaults, designed on the 5-DOF `remus100` preset "
-          "reduced at the reference's speed; truths `5dof` (the design model itself, no uncertainty), `prestero` "
+        + "; every built-in tracking controller with its package defaults"
+        + (" in two gain sets, `designed` (the defaults on this vehicle: gains designed for its actuators' reach, "
+           "compensated form) and `published` (the law's fixed defaults, published form)"
+           if any("gains" in r for r in rows) else "")
+        + ", designed on the 5-DOF `remus100` preset reduced at the reference's speed; truths `5dof` (the design model itself, no uncertainty), `prestero` "
           "(`remus100_prestero`) and `fossen` (`remus100_fossen`), the two 6-DOF with roll and with fins and propeller "
           "(lags, limits) behind the control allocation; start beside the path at speed, propeller trimmed; no "
           "disturbance force.  Steady RMSE of |e| and the time with τ unproducible over the second half, for the "
@@ -364,7 +373,7 @@ def block_model_gap(mg: dict) -> str:
     tally = model_gap_tally(mg)
     for kind, per in tally.items():
         for truth, (nf, n) in per.items():
-            mine = [r for r in rows if r["controller"] == kind and r["truth"] == truth]
+            mine = [r for r in rows if model_gap_label(r) == kind and r["truth"] == truth]
             bad = [r for r in mine if r["status"] != "ok"]
             causes = "; ".join(f"{c.replace('_', ' ')} × {sum(r['cause'] == c for r in bad)} "
                                f"({_span([r['fail_time'] for r in bad if r['cause'] == c], 3)})"

@@ -22,12 +22,28 @@ envelope narrows -- the mechanism by which a large disturbance breaks a rigid en
 B&R's adaptive approximation of the unknown dynamics is not used (the baselines share the
 nominal model; none of them estimates chi except ``backstepping``'s optional bias).
 
+With ``saturation = "compensated"`` the envelope is imposed on the compensated error e~ = e - lam,
+where lam is the response of an auxiliary system to the error acceleration d_a the actuators
+could not produce (d_a = J3 M_bar^-1 (sat(tau) - tau), :mod:`auvtrack.control.saturation`):
+
+    lam_ddot = -2 k_aux lam_dot - k_aux^2 lam + d_a                         (R5, per axis, m/s^2)
+    a        = e_ddot*(e~, e~_dot) - 2 k_aux lam_dot - k_aux^2 lam           (R6)
+
+(R4) evaluated at (e~, e~_dot).  On the nominal plant e~_ddot = e_ddot*(e~, e~_dot) + chi whatever
+the actuators do: eps of e~ obeys the published law eps_ddot = nu + Omega chi while lam carries
+what the saturation took, and lam -> 0 once the actuators deliver again (docs/derivation.md
+section 7).  Without saturation lam = 0 and (R6) is (R4).  This is the modified tracking error of
+command-filtered / auxiliary-system designs (Farrell, Polycarpou, Sharma & Dong 2009, IEEE TAC
+54(6), 1391-1395; Chen, Ge & Ren 2011, Automatica 47(3), 452-465) put in front of Bechlioulis &
+Rovithakis's transformation.
+
 Source: Bechlioulis, C. P. & Rovithakis, G. A. (2008), Robust adaptive control of feedback
 linearizable MIMO nonlinear systems with prescribed performance, IEEE Trans. Autom. Control
 53(9), 2090-2099 (performance function, error transformation).
 
-Packed ``cp`` = [kp, kd, l, rho0 (3), rho_inf (3)]; no internal state; logged aux: rho_x,
-rho_y, rho_z, eps_x, eps_y, eps_z.
+Packed ``cp`` = [kp, kd, l, rho0 (3), rho_inf (3), k_aux, saturation]; internal state: none, or
+(lam (3, m), lam_dot (3, m/s)) when compensated; logged aux: rho_x, rho_y, rho_z, eps_x, eps_y,
+eps_z, and lam as sat_comp_x, sat_comp_y, sat_comp_z when compensated.
 """
 from __future__ import annotations
 
@@ -41,11 +57,14 @@ from ..jit import njit, njit_noalloc
 from ..packing import packed_layout
 from .gain_checks import fmt, require
 from .registry import CompiledController, ControllerParams
+from .saturation import COMPENSATED, SATURATION, accel_deficit, code
 from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "ppc"
 AUX_NAMES = ("rho_x", "rho_y", "rho_z", "eps_x", "eps_y", "eps_z")
-GAINS = packed_layout("PPCGains", kp=1, kd=1, l=1, rho0=3, rho_inf=3)
+COMPENSATION_NAMES = ("sat_comp_x", "sat_comp_y", "sat_comp_z")
+"""Channels added when compensated: lam of (R5), m."""
+GAINS = packed_layout("PPCGains", kp=1, kd=1, l=1, rho0=3, rho_inf=3, k_aux=1, saturation=1)
 AXES = ("x", "y", "z")
 Pos = Annotated[float, Field(gt=0)]
 
@@ -64,6 +83,10 @@ class Params(ControllerParams):
     l: float = Field(0.3, gt=0, description="envelope decay rate, 1/s")
     rho0: tuple[Pos, Pos, Pos] = Field((5.0, 1.5, 1.0), description="rho(0) per axis, m")
     rho_inf: tuple[Pos, Pos, Pos] = Field((0.005, 0.005, 0.005), description="rho(inf) per axis, m")
+    k_aux: float = Field(1.0, gt=0, description="rate of the auxiliary system (R5), 1/s (saturation = 'compensated')")
+    saturation: Literal[SATURATION] = Field(
+        "published", description="'published': eq. (R4); 'compensated': the envelope on the error less the "
+        "auxiliary system's response to what the actuators could not produce (R5)-(R6)")
 
 
 @njit
@@ -98,10 +121,14 @@ def axis(e, ed, rho, rhod, rhodd, kp, kd):
 
 @njit_noalloc(inline="always")
 def control(t, y, xc, args, out):
-    """Compiled PPC law, eq. (R1)-(R4) (tau in N, N m); status 1 if an error reaches its envelope."""
+    """Compiled PPC law, eq. (R1)-(R4), or (R5)-(R6) when compensated (tau in N, N m); status 1 if an error reaches its envelope."""
     e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
     cp, aux = args.cp, out.aux
     kp, kd, l = cp[GAINS.kp], cp[GAINS.kd], cp[GAINS.l]
+    comp = cp[GAINS.saturation] == COMPENSATED
+    if comp:  # the envelope acts on e~ = e - lam (R6)
+        e = (e[0] - xc[0], e[1] - xc[1], e[2] - xc[2])
+        ed = (ed[0] - xc[3], ed[1] - xc[4], ed[2] - xc[5])
     x = math.exp(-l * t)  # shared by the three axes
     r0 = envelope_x(x, cp[GAINS.rho0], cp[GAINS.rho_inf], l)
     r1 = envelope_x(x, cp[GAINS.rho0 + 1], cp[GAINS.rho_inf + 1], l)
@@ -113,7 +140,19 @@ def control(t, y, xc, args, out):
     if st0 + st1 + st2 != 0:
         return 1
     aux[3], aux[4], aux[5] = eps0, eps1, eps2
-    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
+    if not comp:
+        out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
+        return 0
+    k = cp[GAINS.k_aux]
+    b0, b1, b2 = (-2.0 * k * xc[3] - k * k * xc[0], -2.0 * k * xc[4] - k * k * xc[1],
+                  -2.0 * k * xc[5] - k * k * xc[2])  # the auxiliary system's own part of (R5)
+    tau = input_for_accel_forces(y.att, args.vp, f, (a0 + b0, a1 + b1, a2 + b2), gf)
+    out.u[0], out.u[1], out.u[2] = tau
+    da = accel_deficit(y.att, args.vp, tau, args.lo, args.hi)[0]
+    dxc = out.dxc
+    dxc[0], dxc[1], dxc[2] = xc[3], xc[4], xc[5]
+    dxc[3], dxc[4], dxc[5] = b0 + da[0], b1 + da[1], b2 + da[2]
+    aux[6], aux[7], aux[8] = xc[0], xc[1], xc[2]
     return 0
 
 
@@ -144,6 +183,9 @@ def setup(params: Params, ctx) -> CompiledController:
     """Check the envelope against the start ``ctx.e0`` and pack gains and envelope."""
     p = params
     check(p, ctx.e0)
-    cp = GAINS.pack(kp=p.kp, kd=p.kd, l=p.l, rho0=p.rho0, rho_inf=p.rho_inf)
+    cp = GAINS.pack(kp=p.kp, kd=p.kd, l=p.l, rho0=p.rho0, rho_inf=p.rho_inf, k_aux=p.k_aux,
+                    saturation=code(p.saturation))
     xi0 = [float(ctx.e0[i] / p.rho0[i]) for i in range(3)]
-    return CompiledController(cp=cp, xc0=np.zeros(0), aux_names=AUX_NAMES, resolved={"xi0": xi0})
+    comp = p.saturation == "compensated"
+    return CompiledController(cp=cp, xc0=np.zeros(6 if comp else 0),
+                              aux_names=AUX_NAMES + (COMPENSATION_NAMES if comp else ()), resolved={"xi0": xi0})

@@ -21,12 +21,21 @@ the gain 1); (S5) is the exact condition under which the quadratic Lyapunov func
 docs/controllers.md).  :func:`setup` checks the one named by ``gain_condition``.  On the
 sliding set e_dot = -lam e: e -> 0 exponentially.
 
+With ``saturation = "compensated"`` the integral is conditioned on what the actuators could not
+produce (back-calculation, as the PID's eq. P2; Astrom & Hagglund 2006, ch. 3):
+
+    v_dot = -k2 sign(s) + kaw d_a                                          (S3c)
+
+with d_a = J3 M_bar^-1 (sat(tau) - tau) the error acceleration the actuators' reach [``args.lo``,
+``args.hi``] removes on the nominal model (:mod:`auvtrack.control.saturation`, docs/derivation.md
+section 7); d_a = 0 without saturation, where (S3c) is (S3) exactly.
+
 Sources: Levant, A. (1993), Sliding order and sliding accuracy in sliding mode control,
 Int. J. Control 58(6), 1247-1263 (the super-twisting algorithm and its convergence condition);
 Moreno, J. A. & Osorio, M. (2012), Strict Lyapunov functions for the super-twisting algorithm,
 IEEE Trans. Autom. Control 57(4), 1035-1040 (the Lyapunov function V).
 
-Packed ``cp`` = [lam, k1, k2]; internal state xc = v (3, m/s^2); logged aux: sliding_x, sliding_y, sliding_z (s),
+Packed ``cp`` = [lam, k1, k2, kaw, saturation]; internal state xc = v (3, m/s^2); logged aux: sliding_x, sliding_y, sliding_z (s),
 integral_x, integral_y, integral_z (v).
 """
 from __future__ import annotations
@@ -41,11 +50,12 @@ from ..jit import njit, njit_noalloc
 from ..packing import packed_layout
 from .gain_checks import require
 from .registry import CompiledController, ControllerParams
+from .saturation import COMPENSATED, SATURATION, accel_deficit, code
 from .tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "sta"
 AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z", "integral_x", "integral_y", "integral_z")  # s and v
-GAINS = packed_layout("STAGains", lam=1, k1=1, k2=1)
+GAINS = packed_layout("STAGains", lam=1, k1=1, k2=1, kaw=1, saturation=1)
 
 
 class Params(ControllerParams):
@@ -62,6 +72,10 @@ class Params(ControllerParams):
     L: float = Field(0.1, ge=0, description="assumed bound on |d chi/dt|, m/s^3")
     gain_condition: Literal["moreno_osorio", "levant", "none"] = Field(
         "moreno_osorio", description="which finite-time condition setup checks: (S5), (S4), or none")
+    kaw: float = Field(1.0, ge=0, description="back-calculation gain of the integral (saturation = 'compensated'), 1/s")
+    saturation: Literal[SATURATION] = Field(
+        "published", description="'published': eq. (S3); 'compensated': the integral conditioned on the "
+        "actuators' reach (S3c)")
 
 
 @njit
@@ -74,17 +88,23 @@ def axis(e, ed, v, lam, k1, k2):
 
 @njit_noalloc(inline="always")
 def control(t, y, xc, args, out):
-    """Compiled super-twisting law, eq. (S1)-(S3) (tau in N, N m); returns 0."""
+    """Compiled super-twisting law, eq. (S1)-(S3), or (S3c) when compensated (tau in N, N m); returns 0."""
     e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
     cp = args.cp
     lam, k1, k2 = cp[GAINS.lam], cp[GAINS.k1], cp[GAINS.k2]
     s0, a0, d0 = axis(e[0], ed[0], xc[0], lam, k1, k2)
     s1, a1, d1 = axis(e[1], ed[1], xc[1], lam, k1, k2)
     s2, a2, d2 = axis(e[2], ed[2], xc[2], lam, k1, k2)
-    out.dxc[0], out.dxc[1], out.dxc[2] = d0, d1, d2
     aux = out.aux
     aux[0], aux[1], aux[2], aux[3], aux[4], aux[5] = s0, s1, s2, xc[0], xc[1], xc[2]
-    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
+    tau = input_for_accel_forces(y.att, args.vp, f, (a0, a1, a2), gf)
+    out.u[0], out.u[1], out.u[2] = tau
+    if cp[GAINS.saturation] == COMPENSATED:
+        da, sat = accel_deficit(y.att, args.vp, tau, args.lo, args.hi)
+        if sat:  # (S3c); without saturation d_a = 0 and (S3) stands as it is
+            kaw = cp[GAINS.kaw]
+            d0, d1, d2 = d0 + kaw * da[0], d1 + kaw * da[1], d2 + kaw * da[2]
+    out.dxc[0], out.dxc[1], out.dxc[2] = d0, d1, d2
     return 0
 
 
@@ -126,7 +146,7 @@ def setup(params: Params, ctx) -> CompiledController:
     """Check the gain condition and pack the gains; v(0) = 0."""
     p = params
     check(p)
-    cp = GAINS.pack(lam=p.lam, k1=p.k1, k2=p.k2)
+    cp = GAINS.pack(lam=p.lam, k1=p.k1, k2=p.k2, kaw=p.kaw, saturation=code(p.saturation))
     return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES,
                               resolved={"levant_k1_min": levant_k1_min(p.k2, p.L) if p.k2 > p.L else None,
                                         "moreno_osorio_k2_min": moreno_osorio_k2_min(p.k1, p.L)})

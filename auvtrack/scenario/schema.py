@@ -28,6 +28,7 @@ from ..fields import (Bool, Coefficient, Coefficient5, Fraction, Int, Mass5, Non
 from ..vehicle.vehicle_file import is_vehicle_ref, resolve_path
 from ..reference import build_reference
 from .components import check_disturbances, check_reference, jsonable
+from .designed import designed_controller
 from .errors import format_value
 from .names import check_name
 
@@ -428,6 +429,23 @@ def _check_number(path: str, value: Any) -> None:
         raise ValueError(f"{path}: must be a finite number (got {format_value(value)})")
 
 
+def _with_u0(data: Mapping) -> Mapping:
+    """``data`` with ``vehicle.u0`` of a reduced preset filled with the mean speed of the reference."""
+    veh = data.get("vehicle", {})
+    if not isinstance(veh, Mapping) or veh.get("u0") is not None:
+        return data
+    name = veh.get("preset", "paper")
+    if not isinstance(name, str) or not is_reduced(name):
+        return data
+    try:  # an invalid reference or duration is reported by its own validator
+        ref = build_reference(check_reference(data.get("reference", {"kind": "helix"})))
+        sim = data.get("sim", {})
+        duration = float(sim.get("duration", SimSection.model_fields["duration"].default))
+    except (ValueError, TypeError, AttributeError):
+        return data
+    return {**data, "vehicle": {**veh, "u0": default_u0(ref, duration)}}
+
+
 def _apply_gain_preset(v: dict) -> dict:
     """Expand ``[controller] preset`` into the preset's gains (explicit keys win).
 
@@ -497,22 +515,12 @@ class Scenario(BaseModel):
     @model_validator(mode="before")
     @classmethod
     def _reduction_speed(cls, data: Any) -> Any:
-        """Fill ``vehicle.u0`` of a reduced preset with the mean speed of the reference."""
+        """Fill ``vehicle.u0`` of a reduced preset with the mean speed of the reference; then the
+        controller's gains designed for the vehicle (:mod:`auvtrack.scenario.designed`)."""
         if not isinstance(data, Mapping):
             return data
-        veh = data.get("vehicle", {})
-        if not isinstance(veh, Mapping) or veh.get("u0") is not None:
-            return data
-        name = veh.get("preset", "paper")
-        if not isinstance(name, str) or not is_reduced(name):
-            return data
-        try:  # an invalid reference or duration is reported by its own validator
-            ref = build_reference(check_reference(data.get("reference", {"kind": "helix"})))
-            sim = data.get("sim", {})
-            duration = float(sim.get("duration", SimSection.model_fields["duration"].default))
-        except (ValueError, TypeError, AttributeError):
-            return data
-        return {**data, "vehicle": {**veh, "u0": default_u0(ref, duration)}}
+        return designed_controller(_with_u0(data), DEFAULT_CONTROLLER)
+
     @field_validator("name")
     @classmethod
     def _name(cls, v: str) -> str:

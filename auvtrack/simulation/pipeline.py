@@ -30,6 +30,7 @@ from ..vehicle.presets import vehicle_arrays  # noqa: F401  (re-exported: studie
 from ..reference import build_reference
 from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
+from ..scenario.designed import design_record
 from ..scenario.plan import plan_run
 from ..interrupt import Outcome, run_in_thread
 from ..user_modules import first_line, load_module
@@ -188,7 +189,7 @@ def prepare(scenario: Scenario) -> Prepared:
         channels=channels,
         notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[VP.ell])] if n),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
-                  "controller": cc.resolved},
+                  "controller": {**cc.resolved, **design_record(sc)}},
         statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
     )
 

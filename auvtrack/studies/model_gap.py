@@ -19,12 +19,22 @@ over three references at a REMUS speed and turn radius both truths can fly (1.25
 the model gap is the disturbance.  The vehicle starts 0.5 m beside the reference's start at the
 reference speed, its propeller trimmed (:func:`auvtrack.plant.sixdof.truth.trim_rpm`).
 
+Every controller flies each case twice (``gains``):
+
+=============  ===================================================================
+``designed``   the defaults on the ``remus100`` design vehicle: gains designed for its actuators'
+               reach and ``saturation = "compensated"`` (docs/controllers.md, "Gains designed for
+               the vehicle"; :mod:`auvtrack.control.design`)
+``published``  the law's fixed default gains (Section 4's) and its published form
+               (``saturation = "published"``; the PID without back-calculation)
+=============  ===================================================================
+
 Reported per run: status and failure cause (pitch, roll, envelope, divergence, ...), steady-state
 tracking error (RMSE and max |e| over the second half), the navigation point's cross-track RMSE
 and maximum against the path over the second half (the path-following metrics, docs/metrics.md),
-and actuator usage: the time each
-actuator sits at its limit (fins at delta_max, propeller at n_max) and the fins' rate
-(RMS and max |d delta / dt| from the log).  ``--quick`` runs the helix without current for 20 s.
+and actuator usage: the time each actuator sits at its limit (fins at delta_max, propeller at
+n_max) and the fins' rate (RMS and max |d delta / dt| from the log).  ``--quick`` runs the helix
+without current for 20 s.
 """
 from __future__ import annotations
 
@@ -53,6 +63,8 @@ REFERENCES = {
                                                   [110.0, 90.0, 6.0], [60.0, 120.0, 4.0]], "speed": SPEED},
 }
 ELL = 1.0  # m, virtual-point offset (remus100 preset)
+GAINS = ("designed", "published")
+"""The two gain sets every controller flies (module docstring)."""
 
 
 def controllers() -> list[str]:
@@ -74,17 +86,42 @@ def start_pose(ref_spec: dict, ell: float = ELL) -> tuple[list[float], list[floa
     return eta, [speed, 0.0, 0.0, 0.0, 0.0]
 
 
-def scenario(controller: str, truth: str, reference: str, current: bool, duration: float) -> dict:
-    """The scenario (a dict for :func:`auvtrack.scenario.load_scenario`) of one run."""
+def controller_section(controller: str, gains: str = "designed") -> dict:
+    """The ``[controller]`` section of one gain set of :data:`GAINS`.
+
+    Parameters
+    ----------
+    controller : str
+        ``controller.kind``.
+    gains : str
+        ``"designed"``: the kind only (the defaults on the remus100: designed gains, compensated
+        form); ``"published"``: the law's fixed defaults in its published form.
+
+    Returns
+    -------
+    dict
+        The section.
+    """
+    from ..control import CONTROLLERS
+
+    if gains == "designed":
+        return {"kind": controller}
+    published = {"saturation": "published"} if "saturation" in CONTROLLERS[controller].params.model_fields else {}
+    return {"kind": controller, "preset": "defaults", **published}
+
+
+def scenario(controller: str, truth: str, reference: str, current: bool, duration: float,
+             gains: str = "designed") -> dict:
+    """The scenario (a dict for :func:`auvtrack.scenario.load_scenario`) of one run (``gains``: one of :data:`GAINS`)."""
     ref = REFERENCES[reference]
     eta, nu = start_pose(ref)
     sc = {
-        "name": f"model-gap-{controller}-{truth}-{reference}-{'current' if current else 'calm'}",
+        "name": f"model-gap-{controller}-{gains}-{truth}-{reference}-{'current' if current else 'calm'}",
         "sim": {"duration": duration, "dt": 0.001, "log_dt": 0.01},
         "vehicle": {"preset": "remus100", "l": ELL},
         "reference": ref,
         "initial": {"eta": eta, "nu": nu},
-        "controller": {"kind": controller},
+        "controller": controller_section(controller, gains),
         "disturbance": [CURRENT] if current else [],
         "metrics": {"window": [duration / 2, duration]},
     }
@@ -96,10 +133,10 @@ def scenario(controller: str, truth: str, reference: str, current: bool, duratio
 
 
 def jobs(quick: bool) -> list[tuple]:
-    """Every (controller, truth, reference, current) of the study."""
+    """Every (controller, truth, reference, current, gains) of the study."""
     refs = ("helix",) if quick else tuple(REFERENCES)
     currents = (False,) if quick else (False, True)
-    return [(k, t, r, c) for k in controllers() for t in TRUTHS for r in refs for c in currents]
+    return [(k, t, r, c, g) for k in controllers() for g in GAINS for t in TRUTHS for r in refs for c in currents]
 
 
 def _at_limit(x: np.ndarray, limit: float) -> np.ndarray:
@@ -107,13 +144,13 @@ def _at_limit(x: np.ndarray, limit: float) -> np.ndarray:
 
 
 def summarise(job: tuple, res, limits: dict | None) -> dict:
-    """One result row: status, cause, tracking error, actuator usage."""
-    kind, truth, ref, current = job
+    """One result row: status, cause, tracking error, path-following errors, actuator usage."""
+    kind, truth, ref, current, gains = job
     ch = res.channels
     t = ch["t"]
     T = t[-1] if t.size else 0.0
-    row = {"controller": kind, "truth": truth, "reference": ref, "current": current, "status": res.status,
-           "cause": failure_cause(res), "fail_time": res.failure["time"] if res.failure else None}
+    row = {"controller": kind, "gains": gains, "truth": truth, "reference": ref, "current": current,
+           "status": res.status, "cause": failure_cause(res), "fail_time": res.failure["time"] if res.failure else None}
     if t.size == 0:  # stopped before the first logged row
         row.update(rmse_late=None, max_e_late=None, max_theta_deg=None)
         row["duration_run"] = 0.0
@@ -169,9 +206,11 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     duration = 20.0 if quick else 150.0
     rows = []
     for job in tqdm(jobs(quick), disable=not progress, desc="model-gap"):
-        sc = load_scenario(scenario(*job, duration))
+        kind, truth, ref, current, gains = job
+        sc = load_scenario(scenario(kind, truth, ref, current, duration, gains))
         res = run_prepared(prepare(sc))
-        rows.append(summarise(job, res, sc.plant.actuator_limits() if hasattr(sc.plant, "actuator_limits") else None))
+        limits = sc.plant.actuator_limits() if hasattr(sc.plant, "actuator_limits") else None  # 6-DOF truths only
+        rows.append(summarise(job, res, limits))
     write_json(out / "results.json", {"duration_s": duration, "quick": quick, "rows": rows,
                                       "references": {k: REFERENCES[k] for k in {r["reference"] for r in rows}},
                                       "current": CURRENT})
@@ -180,18 +219,19 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     rep.paragraph(
         f"Design model: `remus100` (5-DOF, reduced at the reference's speed). Truths: its own 5-DOF model "
         f"(no uncertainty), `remus100_prestero`, `remus100_fossen` (6-DOF, fins and propeller through the "
-        f"control allocation). {duration:g} s runs; errors and the time with tau unproducible (the "
-        f"allocation's saturation flags) over the second half; fins / rpm at limit and fin rates over the "
-        f"whole run (fractions of the logged samples). Current: "
+        f"control allocation). Gains: `designed` (the defaults on this vehicle: designed for its actuators' "
+        f"reach, compensated form) and `published` (the law's fixed defaults, published form). {duration:g} s "
+        f"runs; errors and the time with tau unproducible (the allocation's saturation flags) over the second "
+        f"half; the navigation point's path-following errors over the second half; fins / rpm at limit and fin rates over the whole run (fractions of the logged samples). Current: "
         f"Gauss-Markov, mean {CURRENT['mean']} m/s, sigma {CURRENT['sigma']} m/s.")
     rep.heading("Failures by cause")
-    rep.table(["controller", "truth", "runs", "failed", "causes"], _failure_table(rows))
+    rep.table(["controller", "gains", "truth", "runs", "failed", "causes"], _failure_table(rows))
     rep.heading("Runs")
-    rep.table(["controller", "truth", "reference", "current", "status", "rmse late (m)", "max \\|e\\| late (m)",
-               "xtrack rmse / max late (m)",
+    rep.table(["controller", "gains", "truth", "reference", "current", "status", "rmse late (m)",
+               "max \\|e\\| late (m)", "xtrack rmse / max late (m)",
                "max \\|theta\\| (deg)", "max \\|phi\\| (deg)", "tau unproducible u / q / r (s)", "fins at limit (r / s)",
                "rpm at limit", "fin rate rms r / s (rad/s)"],
-              [[r["controller"], r["truth"], r["reference"], "yes" if r["current"] else "no",
+              [[r["controller"], r.get("gains", "designed"), r["truth"], r["reference"], "yes" if r["current"] else "no",
                 "ok" if r["status"] == "ok" else f"failed: {r['cause']} at {r['fail_time']:.3g} s",
                 r["rmse_late"], r["max_e_late"], _pair(r.get("xtrack_rmse_late"), r.get("xtrack_max_late")),
                 r["max_theta_deg"], r.get("max_phi_deg"),
@@ -208,11 +248,15 @@ def _pair(a, b) -> str:
 def _failure_table(rows: list[dict]) -> list[list]:
     out = []
     for kind in dict.fromkeys(r["controller"] for r in rows):
-        for truth in TRUTHS:
-            mine = [r for r in rows if r["controller"] == kind and r["truth"] == truth]
-            causes = Counter(r["cause"] for r in mine if r["status"] != "ok")
-            out.append([kind, truth, len(mine), sum(causes.values()),
-                        ", ".join(f"{c} × {n}" for c, n in sorted(causes.items())) or "–"])
+        for gains in GAINS:
+            for truth in TRUTHS:
+                mine = [r for r in rows if r["controller"] == kind and r.get("gains", "designed") == gains
+                        and r["truth"] == truth]
+                if not mine:
+                    continue
+                causes = Counter(r["cause"] for r in mine if r["status"] != "ok")
+                out.append([kind, gains, truth, len(mine), sum(causes.values()),
+                            ", ".join(f"{c} × {n}" for c, n in sorted(causes.items())) or "–"])
     return out
 
 
@@ -226,4 +270,5 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
 
 
 STUDY = StudySpec("model-gap", run, "controllers designed on the 5-DOF REMUS 100 flown on 6-DOF truth "
-                  "models (Prestero, Fossen): failures by cause, tracking, actuator usage")
+                  "models (Prestero, Fossen), designed and published gains: failures by cause, tracking, "
+                  "distance to the path, actuator usage")

@@ -108,8 +108,10 @@ def _prepare(job: Job):
     from ..simulation.pipeline import prepare
 
     vehicle, kind, _, _, overrides = job
-    # the built-in defaults are Section 4; the preset then supplies every vehicle number
-    return prepare(load_scenario({}, [f"vehicle.preset={vehicle}", f"controller.kind={kind}", *overrides]))
+    # the built-in defaults are Section 4 (the law's fixed gains, not those designed for the vehicle);
+    # the preset then supplies every vehicle number
+    return prepare(load_scenario({}, [f"vehicle.preset={vehicle}", f"controller.kind={kind}",
+                                      "controller.preset=defaults", *overrides]))
 
 
 def _row(job: Job, res) -> dict:

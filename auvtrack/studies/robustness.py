@@ -169,9 +169,8 @@ def sample_scenario(s: Sample, vehicle: str, kind: str, preset: str | None, dura
     dict
         Input of :func:`auvtrack.scenario.load_scenario`.
     """
-    ctrl: dict[str, Any] = {"kind": kind}
-    if preset is not None:
-        ctrl["preset"] = preset
+    # the package defaults are the law's fixed defaults, not the gains designed for the vehicle
+    ctrl: dict[str, Any] = {"kind": kind, "preset": "defaults" if preset is None else preset}
     return {
         "name": f"robustness-{vehicle}-{kind}-{s.index}", "seed": s.index,
         "sim": {"duration": duration, "dt": dt, "log_dt": LOG_DT},

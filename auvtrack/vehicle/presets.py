@@ -10,6 +10,12 @@ from.  Registering a preset means adding its file: :func:`available` lists the f
   from the 6-DOF ``remus100_prestero`` data (``get_preset("remus100", u0=...)``; reduction in
   ``docs/vehicles.md``).
 
+A reduced preset also knows its actuators' *reach* at U0: the tau its fins and propeller produce
+at their limits in straight running at U0 (``reach``, with its source), computed by the 6-DOF
+model it is reduced from; the plant contributes that computation (:func:`register_reach`), and a
+preset stored as numbers (``paper``) has none.  The gain design of
+:mod:`auvtrack.control.design` uses it.
+
 Other design models come from *preset sources* that plants register (:func:`register_source`):
 the 6-DOF truths contribute the reduction of a Fossen-type torpedo
 (:mod:`auvtrack.plant.sixdof.torpedo_reduction`), so that a preset may also be a vehicle file's path
@@ -55,6 +61,10 @@ class VehiclePreset:
         Per field: ``{"unit": ..., "source": ...}``.
     u0 : float or None
         Linearisation speed (m/s) of a reduced preset; None for a preset stored as numbers.
+    reach : tuple of 3 float or None
+        (tau_u (N), tau_q, tau_r (N m)): what the actuators produce at their limits in straight
+        running at ``u0`` (the smaller magnitude of the two limits per axis); None when unknown.
+        Its source is ``sources["reach"]``.
     """
 
     name: str
@@ -65,6 +75,7 @@ class VehiclePreset:
     l: float
     sources: dict
     u0: float | None = None
+    reach: tuple[float, float, float] | None = None
 
 
 def available() -> list[str]:
@@ -125,6 +136,39 @@ def register_source(source: PresetSource) -> PresetSource:
     return source
 
 
+REACH: list[Callable[[str, float], tuple[tuple[float, float, float], str] | None]] = []
+"""Registered reach computations: ``fn(model, u0) -> (reach, source)`` or None for a model it does not know."""
+
+
+def register_reach(fn: Callable[[str, float], tuple[tuple[float, float, float], str] | None]) -> None:
+    """Add a computation of the actuators' reach of a 6-DOF model at a speed (see :data:`REACH`).
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(model, u0) -> ((tau_u, tau_q, tau_r), source)``, or None for a model it does not know.
+    """
+    REACH.append(fn)
+
+
+def reach_of(model: str, u0: float) -> tuple[tuple[float, float, float], str] | None:
+    """The reach of a 6-DOF model at ``u0`` from the first registered computation that knows it.
+
+    Parameters
+    ----------
+    model : str
+        A 6-DOF model (e.g. ``remus100_prestero``) or vehicle file.
+    u0 : float
+        Speed, m/s.
+
+    Returns
+    -------
+    tuple or None
+        ((tau_u (N), tau_q, tau_r (N m)), source), or None when no computation knows the model.
+    """
+    return next((r for r in (fn(model, u0) for fn in REACH) if r is not None), None)
+
+
 def _source_of(name: object) -> PresetSource | None:
     return next((src for src in SOURCES if src.accepts(name)), None)
 
@@ -175,11 +219,13 @@ def get_preset(name: str, u0: float | None = None) -> VehiclePreset:
         from .reduction import reduce_prestero  # a reduced preset: numbers from its 6-DOF data
         speed = float(raw["u0"]["value"]) if u0 is None else u0
         red = reduce_prestero(speed)
+        reach = reach_of(raw["reduction_of"], speed)
+        extra = {} if reach is None else {"reach": {"unit": "N, N m, N m", "source": reach[1]}}
         return VehiclePreset(
             name=raw["name"], description=raw.get("description", ""), m=red["m"], d=red["d"],
             wgml=red["wgml"], l=float(raw["l"]["value"]),
-            sources={**red["sources"], "l": {"unit": raw["l"]["unit"], "source": raw["l"]["source"]}},
-            u0=speed)
+            sources={**red["sources"], "l": {"unit": raw["l"]["unit"], "source": raw["l"]["source"]}, **extra},
+            u0=speed, reach=None if reach is None else reach[0])
     if u0 is not None:
         raise ValueError(f"vehicle.u0: only a reduced preset has a linearisation speed; {name!r} is stored as numbers (got {u0!r})")
     vals = {k: raw[k]["value"] for k in _FIELDS}
@@ -232,6 +278,7 @@ def vehicle_arrays(sc) -> tuple[np.ndarray, np.ndarray, dict]:
     vp_true = pack_vehicle(m * (1 + u.M), d * (1 + u.D), wgml * (1 + u.G), ell, 1.0 + u.C)
     record = {"preset": pre.name, "m": m.tolist(), "d": d.tolist(), "wgml": wgml, "l": ell,
               "sources": pre.sources, **({"u0": pre.u0} if pre.u0 is not None else {}),
+              **({"reach": list(pre.reach)} if pre.reach is not None else {}),
               "true_plant": {"m": (m * (1 + u.M)).tolist(), "d": (d * (1 + u.D)).tolist(),
                              "wgml": wgml * (1 + u.G), "c_scale": 1.0 + u.C}}
     return vp_nom, vp_true, record

@@ -81,9 +81,9 @@ def _setup(mod, extra=(), e0=(0.0, 0.0, 0.0), tau_max=(math.inf,) * 3):
     return mod.setup(sc.controller, ctx)
 
 
-def _call(mod, cc, t, eta, nu, att, xc, refm):
+def _call(mod, cc, t, eta, nu, att, xc, refm, reach=UNLIMITED):
     tau, dxc, aux = np.zeros(3), np.zeros(xc.size), np.zeros(len(cc.aux_names))
-    args = LawArgs(np.ascontiguousarray(refm), np.zeros(0), cc.cp, VP_NOM, *UNLIMITED, (0.0, 0.0, 0.0), 0.0, WORK)
+    args = LawArgs(np.ascontiguousarray(refm), np.zeros(0), cc.cp, VP_NOM, *reach, (0.0, 0.0, 0.0), 0.0, WORK)
     status = mod.control(t, Measured(eta, nu, att), xc, args, LawOutputs(tau, dxc, aux))
     return status, tau, dxc, aux
 
@@ -111,12 +111,12 @@ def test_pid_commands_its_design_law_at_any_state(seed):
 @settings(max_examples=40)
 @given(st.integers(0, 2**32 - 1))
 def test_pid_back_calculation_under_saturation(seed):
-    """I_dot = e - (kaw / ki) J3 M^-1 (sat(tau) - tau) (eq. P2): the e_ddot the saturation removes."""
+    """I_dot = e - (kaw / ki) J3 M^-1 (sat(tau) - tau) (eq. P2): the e_ddot the actuators' reach removes."""
     rng, eta, nu, att, refm, t = _state(seed)
     tau_max = (50.0, 5.0, 5.0)
-    cc = _setup(pid, ["controller.kaw=0.8"], tau_max=tau_max)
+    cc = _setup(pid, ["controller.kaw=0.8"])
     xc = rng.normal(0.0, 1.0, 3)
-    _, tau, dxc, _ = _call(pid, cc, t, eta, nu, att, xc, refm)
+    _, tau, dxc, _ = _call(pid, cc, t, eta, nu, att, xc, refm, reach=(tuple(-m for m in tau_max), tau_max))
     e = np.array(error_state(eta, att, nu, refm, VP_NOM)[0])
     lost = np.clip(tau, -np.array(tau_max), tau_max) - tau
     da = e_ddot_nominal(eta, nu, tau + lost, refm) - e_ddot_nominal(eta, nu, tau, refm)

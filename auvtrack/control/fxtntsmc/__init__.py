@@ -19,10 +19,29 @@ The |z|^(a2-1) of S1_dot (ERRATA 12) is handled by ``surface``: "nonsingular" re
 sig^a2(z) for |z| <= z_switch by the C1 quadratic c1 z + c2 sign(z) z^2 (the same device as
 eq. 27); "printed" keeps eq. (28) and floors |z| at z_floor inside |z|^(a2-1).
 
-Internal state xc = [rho_bar (3), W (3 x m)].  Logged aux channels per axis: rho (envelope),
+With ``saturation = "compensated"`` an auxiliary system carries the part of the error that the
+actuators could not remove, and the whole law (envelope, surface, reaching law, estimator) acts on
+the rest, the compensated error e~ (docs/derivation.md section 7):
+
+    lam_ddot = -2 k_aux lam_dot - k_aux^2 lam + d_a,   e~ = e - lam                 (C1)
+    a        = e_ddot*(e~, e~_dot) - chi_hat - 2 k_aux lam_dot - k_aux^2 lam          (C2)
+
+with d_a = J3 M_bar^-1 (sat(tau) - tau) the error acceleration the actuators' reach removes on the
+nominal model (:mod:`auvtrack.control.saturation`) and e_ddot*, chi_hat the published law's
+(eq. 26-34) evaluated at e~.  Then e~_ddot = e_ddot*(e~) - chi_hat + chi whatever the actuators do:
+S of e~ obeys the published S_dot = nu + G (chi - chi_hat), and the estimator adapts on it, not on
+the error the saturation caused; lam = 0 without saturation, where (C1)-(C2) are the published law
+exactly.  The modified tracking error of Farrell, Polycarpou, Sharma & Dong (2009, IEEE TAC 54(6)),
+with an auxiliary system driven by the input deficit as in Chen, Ge & Ren (2011, Automatica 47(3))
+in its linear form (their extra term for a Lyapunov bound is not used).  The same auxiliary
+system as the PPC's (R5)-(R6).
+
+Internal state xc = [rho_bar (3), W (3 x m)], then lam (3, m) and lam_dot (3, m/s) when compensated.
+Logged aux channels per axis: rho (envelope),
 rho1 (baseline envelope), chi_hat (estimate), sliding (S, the sliding variable), g (envelope trigger),
 zeta (z, the transformed error) and gain_ratio (G/Omega: the effective gain G = Omega - c1 with
-which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band).
+which chi enters S_dot, over Omega of eq. 18; 1 outside the risk monitor's band); when compensated
+also sat_comp (lam of C1).
 """
 from __future__ import annotations
 
@@ -39,6 +58,7 @@ from . import envelopes
 from . import rbf
 from ..registry import CompiledController, ControllerParams
 from ..contract import WORK_SIZE
+from ..saturation import COMPENSATED, SATURATION, accel_deficit, code
 from ..tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "fxtntsmc"
@@ -48,16 +68,19 @@ AUX = packed_layout("FXTNTSMCChannels", rho=3, rho1=3, chi_hat=3, sliding=3, g=3
 """Logged channels per axis: envelope rho and its baseline rho1, the estimate chi_hat, the sliding
 variable S, the risk indicator g, the transformed error zeta (eq. 17) and G/Omega."""
 AUX_NAMES = tuple(f"{n}_{a}" for n in AUX.names for a in AXES)
+COMPENSATION_NAMES = tuple(f"sat_comp_{a}" for a in AXES)
+"""Channels added when compensated: lam of (C1)."""
 
 GAINS = packed_layout("FXTNTSMCParams", kappa1=1, kappa2=1, kappa3=1, a1=1, a2=1, a3=1, a4=1, alpha=1, sigma=1,
                       surface=1, z_switch=1, z_floor=1, envelope=1, envelope_params=envelopes.PARAMS.size,
-                      c1=1, c2=1, beta1=1, beta2=1, estimator=1, neurons=1, width=1, centres=None)
+                      c1=1, c2=1, beta1=1, beta2=1, estimator=1, neurons=1, width=1, k_aux=1, saturation=1,
+                      centres=None)
 """Packed parameters (:func:`setup`): the gains, the envelope kind and its parameters
 (:func:`envelopes.axis_transform`), constants precomputed from the gains (c1, c2 of the
 nonsingular quadratic, :func:`surface_coeffs`; beta1, beta2 of eq. 27, :func:`switch_coeffs`), the
-estimator, and the 6 m RBF centres."""
+estimator, the saturation form with its k_aux, and the 6 m RBF centres."""
 STATE = packed_layout("FXTNTSMCState", rho_bar=3, weights=None)
-"""Internal state xc: the envelope filters rho_bar (3), then the RBF weights W (3 m)."""
+"""Internal state xc: the envelope filters rho_bar (3), then the RBF weights W (3 m), then (lam, lam_dot) (6) when compensated."""
 SURFACES = {"nonsingular": 0, "printed": 1}
 MAX_NEURONS = WORK_SIZE  # the basis psi occupies work[0:m]
 
@@ -87,6 +110,10 @@ class Params(ControllerParams):
     )
     z_switch: float = Field(0.01, gt=0, description="|z| below which the nonsingular switch is used")
     z_floor: float = Field(1e-6, gt=0, description="floor on |z| in the printed form's |z|^(a2-1)")
+    k_aux: float = Field(1.0, gt=0, description="rate of the auxiliary system (C1), 1/s (saturation = 'compensated')")
+    saturation: Literal[SATURATION] = Field(
+        "published", description="'published': eq. (26)-(34); 'compensated': the law on the error less the "
+        "auxiliary system's response to what the actuators could not produce (C1)-(C2)")
 
 
 
@@ -265,6 +292,11 @@ def control(t, y, xc, args, out):
     cp, work, dxc, aux = args.cp, args.work, out.dxc, out.aux
     e, ed, f, gf = error_state_forces(y.eta, y.att, y.nu, args.ref, args.vp)
     kind, est, m = int(cp[GAINS.envelope]), int(cp[GAINS.estimator]), int(cp[GAINS.neurons])
+    comp = cp[GAINS.saturation] == COMPENSATED
+    off = STATE.weights + 3 * m  # (lam, lam_dot) of (C1), when compensated
+    if comp:  # the law acts on e~ = e - lam (C2)
+        e = (e[0] - xc[off], e[1] - xc[off + 1], e[2] - xc[off + 2])
+        ed = (ed[0] - xc[off + 3], ed[1] - xc[off + 4], ed[2] - xc[off + 5])
     if est != rbf.NONE:
         rbf.basis(e, ed, cp, GAINS.centres, m, cp[GAINS.width], work)
     printed = cp[GAINS.surface] != 0.0
@@ -311,7 +343,18 @@ def control(t, y, xc, args, out):
         chat = rbf.estimate_and_adapt3(xc, STATE.weights, m, work, (S0, S1, S2), gain, dxc)
     aux[AUX.chi_hat], aux[AUX.chi_hat + 1], aux[AUX.chi_hat + 2] = chat
     acc = (edd0 - chat[0], edd1 - chat[1], edd2 - chat[2])
-    out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, acc, gf)
+    if not comp:
+        out.u[0], out.u[1], out.u[2] = input_for_accel_forces(y.att, args.vp, f, acc, gf)
+        return 0
+    k = cp[GAINS.k_aux]
+    b0, b1, b2 = (-2.0 * k * xc[off + 3] - k * k * xc[off], -2.0 * k * xc[off + 4] - k * k * xc[off + 1],
+                  -2.0 * k * xc[off + 5] - k * k * xc[off + 2])  # the auxiliary system's own part of (C1)
+    tau = input_for_accel_forces(y.att, args.vp, f, (acc[0] + b0, acc[1] + b1, acc[2] + b2), gf)
+    out.u[0], out.u[1], out.u[2] = tau
+    da = accel_deficit(y.att, args.vp, tau, args.lo, args.hi)[0]
+    dxc[off], dxc[off + 1], dxc[off + 2] = xc[off + 3], xc[off + 4], xc[off + 5]
+    dxc[off + 3], dxc[off + 4], dxc[off + 5] = b0 + da[0], b1 + da[1], b2 + da[2]
+    aux[AUX.size], aux[AUX.size + 1], aux[AUX.size + 2] = xc[off], xc[off + 1], xc[off + 2]
     return 0
 
 
@@ -366,11 +409,15 @@ def setup(params: Params, ctx) -> CompiledController:
                         lambda3=env.lambda3, threshold=env.reactive_threshold, printed=float(printed), rho0=rho0,
                         rho_inf=rho_inf),
                     c1=c1, c2=c2, beta1=beta1, beta2=beta2,
-                    estimator=rbf.ESTIMATORS[est.kind], neurons=m, width=est.width, centres=centres.ravel())
+                    estimator=rbf.ESTIMATORS[est.kind], neurons=m, width=est.width, k_aux=p.k_aux,
+                    saturation=code(p.saturation), centres=centres.ravel())
     xc0 = STATE.pack(rho_bar=rb0, weights=weights.ravel())
+    comp = p.saturation == "compensated"
+    if comp:
+        xc0 = np.concatenate([xc0, np.zeros(6)])  # lam(0) = lam_dot(0) = 0
     resolved = {"rho_bar0": rb0.tolist(), "rbf_centres": centres.tolist(), "rbf_weights0": weights.tolist()}
-    return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES, notes=tuple(notes),
-                              resolved=resolved)
+    return CompiledController(cp=cp, xc0=xc0, aux_names=AUX_NAMES + (COMPENSATION_NAMES if comp else ()),
+                              notes=tuple(notes), resolved=resolved)
 
 
 def warnings(params: Params) -> list[str]:

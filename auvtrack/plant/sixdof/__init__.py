@@ -15,15 +15,17 @@ stern plane, rudder) pass through.
 from __future__ import annotations
 
 from ...jit import njit_noalloc
-from ...vehicle.presets import register_source
+from ...vehicle.presets import register_reach, register_source
 from . import fossen, prestero
 from .actuators import effective
 from .common import accel5, attitude_cause6, direct_command, environment, log_extra, pose  # noqa: F401
 from .layout import CMD_TAU, EQUATIONS_FOSSEN, LOG_NAMES6, NX6, P_DIRECT, P_DMAX, P_EQUATIONS, P_NMAX
+from .reach import reach_at
 from .section import Section, check_scenario  # noqa: F401
 from .torpedo_reduction import SOURCE as _TORPEDO_DESIGNS
 
 register_source(_TORPEDO_DESIGNS)  # a Fossen-type torpedo file is also a 5-DOF design preset
+register_reach(reach_at)  # a reduced design preset knows its truth's actuator reach
 
 NAME = "6dof"
 STATE = ("x", "y", "z", "phi", "theta", "psi", "u", "v", "w", "p", "q", "r", "delta_r", "delta_s", "n")

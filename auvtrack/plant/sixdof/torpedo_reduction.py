@@ -123,18 +123,23 @@ def torpedo_preset(name: str, u0: float | None) -> VehiclePreset:
     Returns
     -------
     VehiclePreset
-        The reduced numbers with their sources.
+        The reduced numbers with their sources, and the actuators' reach at ``u0``
+        (:func:`auvtrack.plant.sixdof.reach.reach_at`).
     """
     from ...vehicle.vehicle_file import label, load_vehicle_file
 
     path = torpedo_source(name)
     pr = load_vehicle_file(path)
     speed = pr.values["design.u0"] if u0 is None else u0
+    from .reach import reach_at
+
     red = reduce_torpedo(pr, speed, origin=name if name in TORPEDO_PRESETS else label(path))
     l_src = pr.record["design"]["l"]
+    reach, reach_src = reach_at(name if name in TORPEDO_PRESETS else path, speed)
     return VehiclePreset(name=name, description=f"{pr.description} (5-DOF reduction at U0)".strip(),
                          m=red["m"], d=red["d"], wgml=red["wgml"], l=float(pr.values["design.l"]),
-                         sources={**red["sources"], "l": {"unit": "m", "source": l_src["source"]}}, u0=speed)
+                         sources={**red["sources"], "l": {"unit": "m", "source": l_src["source"]},
+                                  "reach": {"unit": "N, N m, N m", "source": reach_src}}, u0=speed, reach=reach)
 
 
 SOURCE = PresetSource(names=lambda: TORPEDO_PRESETS, accepts=lambda name: torpedo_source(name) is not None,
