@@ -6,6 +6,7 @@ and the cause.
 """
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -49,7 +50,8 @@ def compile_error_line(text: str, label: str) -> str:
     """
     package = str(Path(__file__).resolve().parents[1])
     cache = str(cache_dir().parent)
-    user = [(f, n) for f, n in _LOCATION.findall(text)
+    found = [(os.path.abspath(f), n) for f, n in _LOCATION.findall(text)]  # Numba may report paths relative to cwd
+    user = [(f, n) for f, n in found
             if not f.startswith(package) and not f.startswith(cache) and "site-packages" not in f]
     cause = ""
     for line in text.splitlines():

@@ -187,7 +187,8 @@ def test_ppc_reports_an_error_on_its_envelope():
     cc = _setup(ppc)
     refm[0] = np.array(virtual_point(eta, att, VP_NOM[LAYOUT.ell])) - (0.0, ppc.Params().rho0[1], 0.0)  # e_y = rho0_y, t = 0
     assert _call(ppc, cc, 0.0, eta, nu, att, np.zeros(0), refm)[0] == 1
-    assert ppc.STATUS[1].startswith("envelope violated")
+    from auvtrack.control.contract import CONTROLLER_STATUS
+    assert CONTROLLER_STATUS[1].startswith("envelope violated")
 
 
 @settings(max_examples=60)

@@ -209,10 +209,11 @@ def test_setup_packs_the_precomputed_coefficients():
     from auvtrack.control import fxtntsmc as F
     p = prepare(load_scenario(PAPER, ["sim.duration=0.1", "controller.a2=0.7", "controller.alpha=0.65"]))
     assert p.cp[F.GAINS.c1] == pytest.approx((2 - 0.7) * 0.01 ** (0.7 - 1), rel=1e-15)
-    assert p.cp[F.SC2] == pytest.approx((0.7 - 1) * 0.01 ** (0.7 - 2), rel=1e-15)
-    assert p.cp[F.SB1] == pytest.approx((2 - 0.65) * 0.005 ** (0.65 - 1), rel=1e-15)
-    assert p.cp[F.SB2] == pytest.approx((0.65 - 1) * 0.005 ** (0.65 - 2), rel=1e-15)
-    assert p.cp[F.EST] == 3 and p.cp[F.NEUR] == 7  # Section 4: effective-gain law (default), 7 neurons
+    assert p.cp[F.GAINS.c2] == pytest.approx((0.7 - 1) * 0.01 ** (0.7 - 2), rel=1e-15)
+    assert p.cp[F.GAINS.beta1] == pytest.approx((2 - 0.65) * 0.005 ** (0.65 - 1), rel=1e-15)
+    assert p.cp[F.GAINS.beta2] == pytest.approx((0.65 - 1) * 0.005 ** (0.65 - 2), rel=1e-15)
+    # Section 4: effective-gain law (default), 7 neurons
+    assert p.cp[F.GAINS.estimator] == 3 and p.cp[F.GAINS.neurons] == 7
 
 
 def test_ftsmc_sig_pair_matches_two_sig_calls():

@@ -163,7 +163,9 @@ def _states(prep, n, seed):
 
 @pytest.mark.parametrize("kind", builtin_controllers())
 def test_each_law_in_lane_form_equals_the_scalar_law(kind):
-    from auvtrack.control.contract import WORK_SIZE
+    """Each law, rewritten to lanes, gives the scalar law's status and outputs bit for bit: at states
+    near the run's start, with a finite actuator reach (the saturation-aware forms are exercised)."""
+    from auvtrack.control.contract import WORK_SIZE, LawArgs, LawOutputs, Measured
     from auvtrack.vehicle.kinematics import attitude
 
     preps = [prepare(load_scenario(PAPER, {"controller.kind": kind, "seed": i, "sim.duration": 1.0}))
@@ -175,34 +177,46 @@ def test_each_law_in_lane_form_equals_the_scalar_law(kind):
     cp = np.stack([p.cp for p in preps])
     vp = np.stack([p.vp_nom for p in preps])
     xc = np.stack([p.controller.x0 for p in preps])
+    path = np.stack([p.ref_p for p in preps])
+    rng = np.random.default_rng(5)
+    hi = rng.uniform(5.0, 60.0, (L, 3))  # a finite reach, different per run
+    lo = -hi * rng.uniform(0.5, 1.0, (L, 3))
+    ap = rng.uniform(-1.0, 1.0, (L, 3)) * hi
+    h = np.zeros(L)
 
     @numba.njit
-    def scalar(X, T, refm, cp, vp, xc, tau, dxc, aux, st):
+    def scalar(X, T, refm, path, cp, vp, xc, lo, hi, ap, h, tau, dxc, aux, st):
         work = np.zeros(WORK_SIZE)
         for i in range(X.shape[0]):
             x = X[i]
-            st[i] = law(T[i], (x[0], x[1], x[2], x[3], x[4]), (x[5], x[6], x[7], x[8], x[9]), attitude(x[3], x[4]),
-                        xc[i], refm[i], vp[i], cp[i], tau[i], dxc[i], aux[i], work)
+            y = Measured((x[0], x[1], x[2], x[3], x[4]), (x[5], x[6], x[7], x[8], x[9]), attitude(x[3], x[4]))
+            args = LawArgs(refm[i], path[i], cp[i], vp[i], (lo[i, 0], lo[i, 1], lo[i, 2]),
+                           (hi[i, 0], hi[i, 1], hi[i, 2]), (ap[i, 0], ap[i, 1], ap[i, 2]), h[i], work)
+            st[i] = law(T[i], y, xc[i], args, LawOutputs(tau[i], dxc[i], aux[i]))
 
     @numba.njit
-    def lanes(X, T, refm, cp, vp, xc, tau, dxc, aux, st):
+    def lanes(X, T, refm, path, cp, vp, xc, lo, hi, ap, h, tau, dxc, aux, st):
         x = as_lanes(X, L)
         m = full_mask(L)
-        work = as_lanes(np.zeros((WORK_SIZE, L)), L)
-        r = lane_law(as_lanes(T, L)[0], (x[0], x[1], x[2], x[3], x[4]), (x[5], x[6], x[7], x[8], x[9]),
-                     lane_att(x[3], x[4], m), as_lanes(xc, L), as_lanes(refm, L), as_lanes(vp, L), as_lanes(cp, L),
-                     as_lanes(tau, L), as_lanes(dxc, L), as_lanes(aux, L), work, m)
+        lo_, hi_, ap_ = as_lanes(lo, L), as_lanes(hi, L), as_lanes(ap, L)
+        y = Measured((x[0], x[1], x[2], x[3], x[4]), (x[5], x[6], x[7], x[8], x[9]), lane_att(x[3], x[4], m))
+        args = LawArgs(as_lanes(refm, L), as_lanes(path, L), as_lanes(cp, L), as_lanes(vp, L),
+                       (lo_[0], lo_[1], lo_[2]), (hi_[0], hi_[1], hi_[2]), (ap_[0], ap_[1], ap_[2]),
+                       as_lanes(h, L)[0], as_lanes(np.zeros((WORK_SIZE, L)), L))
+        r = lane_law(as_lanes(T, L)[0], y, as_lanes(xc, L), args,
+                     LawOutputs(as_lanes(tau, L), as_lanes(dxc, L), as_lanes(aux, L)), m)
         for k in range(L):
             st[k] = get_lane(r, k)
 
     out_s = [np.zeros((L, 3)), np.zeros((L, max(nxc, 1))), np.zeros((L, naux)), np.zeros(L, np.int64)]
-    scalar(X, T, refm, cp, vp, xc, *out_s)
+    scalar(X, T, refm, path, cp, vp, xc, lo, hi, ap, h, *out_s)
 
     def T_(a):
         return np.ascontiguousarray(np.moveaxis(a, 0, -1))
 
     out_l = [np.zeros((3, L)), np.zeros((max(nxc, 1), L)), np.zeros((naux, L)), np.zeros(L, np.int64)]
-    lanes(T_(X), T[None, :].copy(), T_(refm), T_(cp), T_(vp), T_(xc) if nxc else np.zeros((1, L)), *out_l)
+    lanes(T_(X), T[None, :].copy(), T_(refm), T_(path), T_(cp), T_(vp), T_(xc) if nxc else np.zeros((1, L)),
+          T_(lo), T_(hi), T_(ap), h[None, :].copy(), *out_l)
     np.testing.assert_array_equal(out_l[3], out_s[3])
     for a, b in zip(out_l[:3], out_s[:3]):
         np.testing.assert_array_equal(a.T, b)
@@ -256,7 +270,7 @@ def test_simd_batch_on_the_6dof_plants_equals_single_runs():
     from pathlib import Path
 
     remus = Path(__file__).resolve().parents[2] / "scenarios" / "remus100.toml"
-    limits = [5.0, 9.0, 10.0, 11.0, 180.0]
+    limits = [9.0, 9.5, 10.0, 11.0, 180.0]  # above the start roll (8.6 deg)
     track = [{"plant.model": "6dof", "plant.preset": "remus100_prestero", "controller.kind": "fxtntsmc",
               "sim.duration": 0.5 if i % 2 else 0.4, "initial.nu": [1.0, 0.0, 0.0, 0.0, 0.0], "seed": i,
               "initial.phi": 0.15, "sim.phi_limit": limits[i % len(limits)], "sim.control_rate": 100,
@@ -277,7 +291,7 @@ def test_simd_batch_on_the_6dof_plants_equals_single_runs():
 
 def test_simd_mixed_batch_in_input_order():
     """Several controllers, envelopes, estimators, sampled-data control and failures in one call."""
-    from test_batch import CASES
+    from batch.test_batch import CASES
 
     order = [5, 1, 7, 0, 3, 2, 6, 4, 1, 0, 0, 0, 0, 0]
     preps = [prepare(load_scenario(PAPER, CASES[i])) for i in order]
