@@ -35,6 +35,12 @@ and maximum against the path over the second half (the path-following metrics, d
 and actuator usage: the time each actuator sits at its limit (fins at delta_max, propeller at
 n_max) and the fins' rate (RMS and max |d delta / dt| from the log).  ``--quick`` runs the helix
 without current for 20 s.
+
+Only feasible tasks are flown: each (truth, reference, current) is assessed first
+(:func:`auvtrack.feasibility.assess`, the current at its mean + 3 sigma); an infeasible one is
+reported with the check that binds and its runs get status ``"infeasible"`` (not flown).  A
+controller without a designed gain set or a saturation form (the LOS autopilot: its gains are
+placed from the vehicle's model) flies each task once, as ``designed``.
 """
 from __future__ import annotations
 
@@ -132,11 +138,40 @@ def scenario(controller: str, truth: str, reference: str, current: bool, duratio
     return sc
 
 
+def gain_sets(controller: str) -> tuple[str, ...]:
+    """The gain sets of :data:`GAINS` that differ for ``controller`` (``published`` only when its
+    defaults are designed or it has a published saturation form)."""
+    from ..control.design import COMPENSATED_DEFAULT
+    return GAINS if controller in COMPENSATED_DEFAULT else GAINS[:1]
+
+
 def jobs(quick: bool) -> list[tuple]:
     """Every (controller, truth, reference, current, gains) of the study."""
     refs = ("helix",) if quick else tuple(REFERENCES)
     currents = (False,) if quick else (False, True)
-    return [(k, t, r, c, g) for k in controllers() for g in GAINS for t in TRUTHS for r in refs for c in currents]
+    return [(k, t, r, c, g) for k in controllers() for g in gain_sets(k) for t in TRUTHS for r in refs
+            for c in currents]
+
+
+def feasibility(truth: str, reference: str, current: bool, duration: float):
+    """:func:`auvtrack.feasibility.assess` of one task (the controller does not enter)."""
+    from ..feasibility import assess
+    return assess(scenario(controllers()[0], truth, reference, current, duration))
+
+
+def binding_check(f) -> str:
+    """The check of a :class:`~auvtrack.feasibility.Feasibility` that uses most of its limit, in words."""
+    c = max(f.checks, key=lambda k: k.usage)
+    usage = "no steady state" if not math.isfinite(c.usage) else f"{100 * c.usage:.0f}% of {c.limit}"
+    return f"{c.name}: {usage}"
+
+
+def infeasible_row(job: tuple, reason: str) -> dict:
+    """The row of a run not flown because its task is infeasible."""
+    kind, truth, ref, current, gains = job
+    return {"controller": kind, "gains": gains, "truth": truth, "reference": ref, "current": current,
+            "status": "infeasible", "cause": reason, "fail_time": None, "rmse_late": None, "max_e_late": None,
+            "max_theta_deg": None, "duration_run": 0.0}
 
 
 def _at_limit(x: np.ndarray, limit: float) -> np.ndarray:
@@ -204,14 +239,24 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     compile_first([(c, p) for c in controllers() for p in ("5dof", "6dof")], progress=progress)
     out = Path(out)
     duration = 20.0 if quick else 150.0
+    tasks = {}
+    for _, truth, ref, current, _ in jobs(quick):
+        if (truth, ref, current) not in tasks:
+            tasks[truth, ref, current] = feasibility(truth, ref, current, duration)
     rows = []
     for job in tqdm(jobs(quick), disable=not progress, desc="model-gap"):
         kind, truth, ref, current, gains = job
+        f = tasks[truth, ref, current]
+        if f.verdict == "infeasible":
+            rows.append(infeasible_row(job, binding_check(f)))
+            continue
         sc = load_scenario(scenario(kind, truth, ref, current, duration, gains))
         res = run_prepared(prepare(sc))
         limits = sc.plant.actuator_limits() if hasattr(sc.plant, "actuator_limits") else None  # 6-DOF truths only
         rows.append(summarise(job, res, limits))
-    write_json(out / "results.json", {"duration_s": duration, "quick": quick, "rows": rows,
+    feasible = [{"truth": t, "reference": r, "current": c, "verdict": f.verdict,
+                 "binding": binding_check(f) if f.checks else None} for (t, r, c), f in tasks.items()]
+    write_json(out / "results.json", {"duration_s": duration, "quick": quick, "rows": rows, "tasks": feasible,
                                       "references": {k: REFERENCES[k] for k in {r["reference"] for r in rows}},
                                       "current": CURRENT})
     _write_csv(out / "runs.csv", rows)
@@ -224,21 +269,33 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
         f"runs; errors and the time with tau unproducible (the allocation's saturation flags) over the second "
         f"half; the navigation point's path-following errors over the second half; fins / rpm at limit and fin rates over the whole run (fractions of the logged samples). Current: "
         f"Gauss-Markov, mean {CURRENT['mean']} m/s, sigma {CURRENT['sigma']} m/s.")
+    rep.heading("Tasks: feasibility")
+    rep.paragraph("Each task assessed before it is flown (`auvtrack.feasibility`, the current at mean + 3 sigma); "
+                  "infeasible tasks are not flown.")
+    rep.table(["truth", "reference", "current", "verdict", "binding check"],
+              [[f["truth"], f["reference"], "yes" if f["current"] else "no", f["verdict"], f["binding"] or "–"]
+               for f in feasible])
     rep.heading("Failures by cause")
-    rep.table(["controller", "gains", "truth", "runs", "failed", "causes"], _failure_table(rows))
+    rep.table(["controller", "gains", "truth", "runs flown", "failed", "causes"], _failure_table(rows))
     rep.heading("Runs")
     rep.table(["controller", "gains", "truth", "reference", "current", "status", "rmse late (m)",
                "max \\|e\\| late (m)", "xtrack rmse / max late (m)",
                "max \\|theta\\| (deg)", "max \\|phi\\| (deg)", "tau unproducible u / q / r (s)", "fins at limit (r / s)",
                "rpm at limit", "fin rate rms r / s (rad/s)"],
               [[r["controller"], r.get("gains", "designed"), r["truth"], r["reference"], "yes" if r["current"] else "no",
-                "ok" if r["status"] == "ok" else f"failed: {r['cause']} at {r['fail_time']:.3g} s",
+                _status_cell(r),
                 r["rmse_late"], r["max_e_late"], _pair(r.get("xtrack_rmse_late"), r.get("xtrack_max_late")),
                 r["max_theta_deg"], r.get("max_phi_deg"),
                 " / ".join("–" if r.get(f"t_sat_tau_{j}") is None else f"{r[f't_sat_tau_{j}']:.3g}" for j in "uqr"),
                 _pair(r.get("sat_frac_delta_r"), r.get("sat_frac_delta_s")), r.get("sat_frac_rpm"),
                 _pair(r.get("rate_rms_delta_r"), r.get("rate_rms_delta_s"))] for r in rows], digits=3)
     return rep.write()
+
+
+def _status_cell(r: dict) -> str:
+    if r["status"] == "failed":
+        return f"failed: {r['cause']} at {r['fail_time']:.3g} s"
+    return r["status"]
 
 
 def _pair(a, b) -> str:
@@ -254,8 +311,11 @@ def _failure_table(rows: list[dict]) -> list[list]:
                         and r["truth"] == truth]
                 if not mine:
                     continue
-                causes = Counter(r["cause"] for r in mine if r["status"] != "ok")
-                out.append([kind, gains, truth, len(mine), sum(causes.values()),
+                flown = [r for r in mine if r["status"] != "infeasible"]
+                if not flown:
+                    continue
+                causes = Counter(r["cause"] for r in flown if r["status"] != "ok")
+                out.append([kind, gains, truth, len(flown), sum(causes.values()),
                             ", ".join(f"{c} × {n}" for c, n in sorted(causes.items())) or "–"])
     return out
 
