@@ -339,13 +339,20 @@ def model_gap_label(row: dict) -> str:
 
 
 def model_gap_tally(mg: dict) -> dict[str, dict[str, list[int]]]:
-    """Controller (with its gain set) -> truth -> [failed, runs] of the model-gap study."""
+    """Controller (with its gain set) -> truth -> [failed, runs flown] of the model-gap study (runs of
+    infeasible tasks are not flown and not counted)."""
     out: dict[str, dict[str, list[int]]] = {}
     for r in mg["rows"]:
+        if r["status"] == "infeasible":
+            continue
         c = out.setdefault(model_gap_label(r), {}).setdefault(r["truth"], [0, 0])
         c[0] += r["status"] != "ok"
         c[1] += 1
     return out
+
+
+def _task_name(t: dict) -> str:
+    return f"{t['truth']} {t['reference']} {'with current' if t['current'] else 'calm'}"
 
 
 def block_model_gap(mg: dict) -> str:
@@ -353,6 +360,8 @@ def block_model_gap(mg: dict) -> str:
     rows, cur = mg["rows"], mg["current"]
     refs = ", ".join(f"{k} ({_f(_ref_speed(v))} m/s)" for k, v in mg["references"].items())
     currents = sorted({r["current"] for r in rows})
+    infeasible = [t for t in mg.get("tasks", []) if t["verdict"] == "infeasible"]
+    marginal = [t for t in mg.get("tasks", []) if t["verdict"] == "marginal"]
     lines = [
         f"{_f(mg['duration_s'])} s runs" + (" (`--quick`: the helix, calm, only)" if mg["quick"] else "")
         + f"; references {refs}, " + ("calm and with " if currents == [False, True] else "calm" if currents == [False]
@@ -361,31 +370,43 @@ def block_model_gap(mg: dict) -> str:
            if True in currents else "")
         + "; every built-in tracking controller with its package defaults"
         + (" in two gain sets, `designed` (the defaults on this vehicle: gains designed for its actuators' reach, "
-           "compensated form) and `published` (the law's fixed defaults, published form)"
+           "compensated form) and `published` (the law's fixed defaults, published form; the LOS autopilot, whose "
+           "gains are placed from the vehicle's model, flies once)"
            if any("gains" in r for r in rows) else "")
         + ", designed on the 5-DOF `remus100` preset reduced at the reference's speed; truths `5dof` (the design model itself, no uncertainty), `prestero` "
           "(`remus100_prestero`) and `fossen` (`remus100_fossen`), the two 6-DOF with roll and with fins and propeller "
           "(lags, limits) behind the control allocation; start beside the path at speed, propeller trimmed; no "
-          "disturbance force.  Steady RMSE of |e| and the time with τ unproducible over the second half, for the "
-          "runs that completed.", "",
-        "| controller | truth | failed | causes (time of failure, s) | steady RMSE calm (m) | steady RMSE with "
-        "current (m) | τ unproducible u / q / r, max (s) |", "|---|---|---|---|---|---|---|"]
+          "disturbance force.  Steady values over the second half, for the runs that completed: the virtual "
+          "point's RMSE |e| (what the trajectory trackers control) and the navigation point's cross-track RMSE "
+          "`xtrack_rmse` (what a path follower controls), and the time with τ unproducible.", "",
+        "Tasks not flown, infeasible before anything is flown (`auvtrack.feasibility`, the current at mean + 3σ): "
+        + ("; ".join(f"{_task_name(t)} ({t['binding']})" for t in infeasible) or "none") + ".  Marginal (above 80 % "
+        "of a limit) and flown: " + ("; ".join(f"{_task_name(t)} ({t['binding']})" for t in marginal) or "none") + ".",
+        "",
+        "| controller | truth | failed | causes (time of failure, s) | RMSE \\|e\\| calm / current (m) | "
+        "xtrack RMSE calm / current (m) | τ unproducible u / q / r, max (s) |", "|---|---|---|---|---|---|---|"]
     tally = model_gap_tally(mg)
     for kind, per in tally.items():
         for truth, (nf, n) in per.items():
-            mine = [r for r in rows if model_gap_label(r) == kind and r["truth"] == truth]
+            mine = [r for r in rows if model_gap_label(r) == kind and r["truth"] == truth
+                    and r["status"] != "infeasible"]
             bad = [r for r in mine if r["status"] != "ok"]
             causes = "; ".join(f"{c.replace('_', ' ')} × {sum(r['cause'] == c for r in bad)} "
                                f"({_span([r['fail_time'] for r in bad if r['cause'] == c], 3)})"
                                for c in sorted({r["cause"] for r in bad})) or "–"
             ok = [r for r in mine if r["status"] == "ok"]
-            rm = {c: _span([r["rmse_late"] for r in ok if r["current"] is c]) for c in (False, True)}
+
+            def pair(key: str) -> str:
+                return " / ".join(_span([r.get(key) for r in ok if r["current"] is c]) for c in (False, True))
+
             ts = " / ".join(_span([max((r.get(f"t_sat_tau_{j}") or 0.0) for r in ok)]) if ok else "–" for j in INPUTS)
-            lines.append(f"| {kind} | {truth} | {nf} of {n} | {causes} | {rm[False]} | {rm[True]} | {ts} |")
+            lines.append(f"| {kind} | {truth} | {nf} of {n} | {causes} | {pair('rmse_late')} | "
+                         f"{pair('xtrack_rmse_late')} | {ts} |")
     own = {k: v["5dof"] for k, v in tally.items() if "5dof" in v}
     truth = _truth_failures(mg)
     lines += ["", "On their design model: " + ", ".join(f"{k} {n - f} of {n} completed" for k, (f, n) in own.items())
-              + ".  On the 6-DOF truths: " + ", ".join(f"{k} fails {f} of {n}" for k, (f, n) in truth.items()) + "."]
+              + ".  On the 6-DOF truths, of the runs flown: "
+              + ", ".join(f"{k} fails {f} of {n}" for k, (f, n) in truth.items()) + "."]
     return "\n".join(lines)
 
 

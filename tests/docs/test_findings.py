@@ -86,7 +86,10 @@ def test_stored_results_come_from_the_current_study_definitions():
     assert ft["settings"] == _jsonish(asdict(fixed_time.Settings()))
     assert ft["estimator"] == findings.DEFAULT_EST
     rb = findings.load("robustness")
-    assert rb["config"] == _jsonish(asdict(robustness.FULL)) and rb["quick"] is False
+    # workers only say how many threads ran the batch (every back end gives bit-identical results)
+    stored, now = dict(rb["config"]), _jsonish(asdict(robustness.FULL))
+    stored.pop("workers"), now.pop("workers")
+    assert stored == now and rb["quick"] is False
     rl = findings.load("realism")
     assert rl["duration_s"] == 40.0
     rp = findings.load("reproduce")
@@ -165,32 +168,52 @@ def test_the_model_gap_and_remus_prose_holds_on_the_stored_results():
     mg = findings.load("model-gap")
     rows = mg["rows"]
 
-    def mine(kind, truths=("prestero", "fossen"), current=None):  # the fixed defaults, published forms
-        return [r for r in rows if r["controller"] == kind and r["truth"] in truths
-                and (current is None or r["current"] is current) and r.get("gains", "published") == "published"]
+    def mine(kind, truths=("prestero", "fossen"), current=None, gains="published"):
+        return [r for r in rows if r["controller"] == kind and r["truth"] in truths and r["status"] != "infeasible"
+                and (current is None or r["current"] is current) and r["gains"] == gains]
 
-    own = mine("fxtntsmc", ("5dof",))
-    assert all(r["status"] == "ok" for r in own) and max(r["rmse_late"] for r in own) < 1e-3
-    for r in mine("fxtntsmc"):  # fails every truth run, by divergence or envelope violation, early
+    # "calm; every task with the current, and Prestero's waypoint path, are ... not flown"
+    infeasible = {(t["truth"], t["reference"], t["current"]) for t in mg["tasks"] if t["verdict"] == "infeasible"}
+    assert infeasible == {(t, r, True) for t in ("prestero", "fossen") for r in model_gap.REFERENCES} | \
+        {("prestero", "waypoints", False)}
+    assert {t["verdict"] for t in mg["tasks"] if t["truth"] == "prestero" and not t["current"]} - {"infeasible"} \
+        == {"marginal"}  # "marginal on Prestero's truth"
+    for gains in ("published", "designed"):
+        own = mine("fxtntsmc", ("5dof",), gains=gains)
+        assert all(r["status"] == "ok" for r in own) and max(r["rmse_late"] for r in own) < 1e-3
+    for r in mine("fxtntsmc"):  # published: fails every truth run, early
         assert r["status"] != "ok" and r["fail_time"] < 15.0
-        assert r["cause"] in ("state_limit", "nonfinite", "envelope_violation")
-    assert all(r["status"] == "ok" for r in mine("ftsmc", ("5dof", "prestero", "fossen")))
-    assert max(r["rmse_late"] for r in mine("ftsmc", ("5dof",), False)) < 1e-7  # nanometres on its model
-    assert min(r["rmse_late"] for r in mine("ftsmc")) > 0.1  # decimetres or metres on the truths
-    assert max(r["t_sat_tau_u"] for r in mine("ftsmc", ("prestero",))) > 10.0  # propeller, long stretches
-    assert max(r["t_sat_tau_r"] for r in mine("ftsmc", ("fossen",), True)) > 10.0  # rudder with current
+        assert r["cause"] in ("state_limit", "nonfinite")
+    comp_f = mine("fxtntsmc", ("fossen",), gains="designed")
+    assert all(r["status"] == "ok" for r in comp_f) and 0.1 < min(r["rmse_late"] for r in comp_f) \
+        and max(r["rmse_late"] for r in comp_f) < 1.0 and max(r["xtrack_rmse_late"] for r in comp_f) < 1.0
+    comp_p = mine("fxtntsmc", ("prestero",), gains="designed")
+    assert comp_p and all(r["status"] != "ok" and r["cause"] == "envelope_violation" for r in comp_p)
+    assert min(r["fail_time"] for r in comp_p) > max(r["fail_time"] for r in mine("fxtntsmc", ("prestero",)))
+    for gains in ("published", "designed"):
+        assert all(r["status"] == "ok" for r in mine("ftsmc", gains=gains))
+        assert max(r["rmse_late"] for r in mine("ftsmc", ("prestero",), gains=gains)) < 0.2
+        assert max(r["rmse_late"] for r in mine("ftsmc", ("fossen",), gains=gains)) < 0.75
+    half = mg["duration_s"] / 2
+    for kind in ("pid", "backstepping", "sta"):
+        for gains in ("published", "designed"):
+            assert all(r["status"] == "ok" for r in mine(kind, gains=gains))
+        pub = mine(kind)
+        for truth in ("prestero", "fossen"):  # as published: metres on either truth
+            assert max(r["rmse_late"] for r in pub if r["truth"] == truth) > 10.0
+        assert sum(max(r[f"t_sat_tau_{j}"] for j in "uqr") > half / 2 for r in pub) > len(pub) / 2
+        des = mine(kind, gains="designed")
+        assert max(r["rmse_late"] for r in des) < 0.5 and max(r["xtrack_rmse_late"] for r in des) < 0.5
+    for gains in ("published", "designed"):
+        assert all(r["status"] != "ok" and r["cause"] == "envelope_violation" for r in mine("ppc", gains=gains))
+        ppc_own = mine("ppc", ("5dof",), gains=gains)
+        assert [r["current"] for r in ppc_own if r["status"] != "ok"] == [True] * (len(ppc_own) // 2)
+    los = mine("los_autopilot", ("prestero", "fossen"), gains="designed")
+    assert los and all(r["status"] == "ok" for r in los) and max(r["xtrack_rmse_late"] for r in los) < 0.05
+    assert all(0.8 * model_gap.ELL < r["rmse_late"] < 1.2 * model_gap.ELL for r in los)  # about ell behind
     calm_f = [r["rmse_late"] for r in mine("ftsmc", ("fossen",), False)]
     calm_p = [r["rmse_late"] for r in mine("ftsmc", ("prestero",), False)]
     assert min(calm_f) > 2 * max(calm_p)  # the truths disagree with each other
-    half = mg["duration_s"] / 2
-    for kind in ("pid", "backstepping", "sta"):
-        runs = mine(kind)
-        assert all(r["status"] == "ok" for r in runs)
-        assert sum(r["rmse_late"] > 1.0 for r in runs) > len(runs) / 2  # mostly do not track
-        assert sum(max(r[f"t_sat_tau_{j}"] for j in "uqr") > half / 2 for r in runs) > len(runs) / 2
-    assert all(r["status"] != "ok" and r["cause"] == "envelope_violation" for r in mine("ppc"))
-    ppc_own = mine("ppc", ("5dof",))
-    assert 2 * sum(r["status"] != "ok" for r in ppc_own) == len(ppc_own)  # half of its design-model runs
     # §6: the reduction's damping at the operating speed is smaller than at the trial speed
     from auvtrack.vehicle.presets import get_preset
     from auvtrack.vehicle.reduction import reduce_prestero
