@@ -28,7 +28,7 @@ import zlib
 from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, Mapping
+from typing import Annotated, Any, Literal, Mapping
 
 import numpy as np
 from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, ValidationError, field_validator,
@@ -39,7 +39,7 @@ from ..scenario.errors import ScenarioError, translate
 
 __all__ = ["SuiteError", "SuiteFile", "Suite", "Task", "Tier", "Start", "ControllerEntry", "load_suite",
            "available_suites", "CRITERIA", "METRICS", "tracking_kinds", "check_competitor", "resolve_controllers",
-           "start_state", "DEFAULT_SUITE"]
+           "start_state", "DEFAULT_SUITE", "SPLITS", "Split", "Splits"]
 
 DEFAULT_SUITE = "auv-track-v1"
 METRICS: tuple[str, ...] = ("rmse", "itae", "max_error", "settling", "energy", "tv")
@@ -202,6 +202,35 @@ class Quick(_Model):
     bootstrap_resamples: Annotated[int, Strict(), Field(ge=100, le=100_000)] = 500
 
 
+SplitName = Literal["training", "validation"]
+SPLITS: tuple[str, ...] = ("training", "validation", "evaluation")
+"""The purposes a seed index serves: tuning, checking a tuning for over-fitting, the comparison."""
+
+
+class Split(_Model):
+    """Seed indices ``[start, stop)`` of one purpose and the cells it flies (every task and tier by default)."""
+
+    seeds: tuple[Annotated[int, Strict(), Field(ge=0, le=2**31)], Annotated[int, Strict(), Field(ge=1, le=2**31)]]
+    tasks: list[Text] | None = Field(None, description="tasks of the split (default: every task)")
+    tiers: list[Text] | None = Field(None, description="tiers of the split (default: every tier)")
+
+    @model_validator(mode="after")
+    def _range(self) -> "Split":
+        if self.seeds[1] <= self.seeds[0]:
+            raise ValueError(f"seeds: must be [start, stop) with start < stop (got {list(self.seeds)})")
+        return self
+
+
+class Splits(_Model):
+    """Seed indices for tuning (``training``) and for checking a tuning (``validation``).
+
+    The evaluation seeds are ``0 .. seeds - 1`` (the suite's ``seeds``); the three sets are disjoint.
+    """
+
+    training: Split | None = None
+    validation: Split | None = None
+
+
 class MetricsSettings(_Model):
     """``[metrics]``: the settling threshold."""
 
@@ -232,6 +261,7 @@ class SuiteFile(_Model):
     quick: Quick = Field(default_factory=Quick)
     tasks: Annotated[dict[str, Task], Field(min_length=1)]
     tiers: Annotated[dict[str, Tier], Field(min_length=1)]
+    splits: Splits = Field(default_factory=Splits)
 
     @model_validator(mode="after")
     def _names(self) -> "SuiteFile":
@@ -248,7 +278,26 @@ class SuiteFile(_Model):
             except ScenarioError:
                 raise ValueError(f"base: {key!r} is not a dotted scenario key") from None
         _check_run_keys("base", self.base)
+        self._check_splits()
         return self
+
+    def _check_splits(self) -> None:
+        """Each split names known tasks and tiers; training, validation and evaluation seeds are disjoint."""
+        ranges = {"evaluation": (0, self.seeds)}
+        for name in ("training", "validation"):
+            sp = getattr(self.splits, name)
+            if sp is None:
+                continue
+            for section, names, known in (("tasks", sp.tasks, self.tasks), ("tiers", sp.tiers, self.tiers)):
+                for n in names or ():
+                    if n not in known:
+                        raise ValueError(f"splits.{name}.{section}: unknown {section[:-1]} {n!r} "
+                                         f"(the suite has {', '.join(known)})")
+            for other, (a, b) in ranges.items():
+                if sp.seeds[0] < b and a < sp.seeds[1]:
+                    raise ValueError(f"splits.{name}.seeds: [{sp.seeds[0]}, {sp.seeds[1]}) overlaps the {other} "
+                                     f"seeds [{a}, {b}): the sets must be disjoint")
+            ranges[name] = sp.seeds
 
 
 def _check_gain_preset(pattern: str) -> None:
@@ -557,6 +606,42 @@ class Suite:
                 "tier": wilson_halfwidth_max(self.seeds * len(self.tasks), c),
                 "zero_failures": wilson_interval(0, self.seeds, c)[1]}
 
+    def split_seeds(self, split: str) -> range:
+        """The seed indices of ``split`` (one of :data:`SPLITS`; evaluation: those of this variant).
+
+        Raises
+        ------
+        SuiteError
+            ``split`` unknown, or not declared in the suite file.
+        """
+        if split == "evaluation":
+            return range(self.seeds)
+        if split not in SPLITS:
+            raise SuiteError(f"split: must be one of {', '.join(SPLITS)} (got {split!r})")
+        sp = getattr(self.file.splits, split)
+        if sp is None:
+            raise SuiteError(f"{self.source}: splits.{split}: not declared (a [splits.{split}] table with seeds = "
+                             f"[start, stop) outside the evaluation seeds 0 .. {self.file.seeds - 1})")
+        return range(*sp.seeds)
+
+    def split_cells(self, split: str) -> list[tuple[str, str]]:
+        """The (task, tier) cells ``split`` flies, file order (evaluation: every cell)."""
+        sp = None if split == "evaluation" else getattr(self.file.splits, split, None)
+        self.split_seeds(split)  # refuses an unknown or undeclared split
+        tasks = [t for t in self.tasks if sp is None or sp.tasks is None or t in sp.tasks]
+        tiers = [t for t in self.tiers if sp is None or sp.tiers is None or t in sp.tiers]
+        return [(k, r) for k in tasks for r in tiers]
+
+    def split_of(self, index: int) -> str | None:
+        """The split a seed index belongs to (None: none declared holds it)."""
+        if 0 <= index < self.file.seeds:
+            return "evaluation"
+        for name in ("training", "validation"):
+            sp = getattr(self.file.splits, name)
+            if sp is not None and sp.seeds[0] <= index < sp.seeds[1]:
+                return name
+        return None
+
     def quick_variant(self) -> "Suite":
         """The ``--quick`` suite: every task and tier, few seeds, short runs."""
         return replace(self, quick=True)
@@ -650,7 +735,9 @@ class Suite:
 
     def fingerprint(self) -> str:
         """SHA-256 of everything that defines the runs (the file's contents and the variant)."""
-        doc = {"suite": self.file.model_dump(mode="json"), "quick": self.quick, "skipped": list(self._skipped)}
+        suite = self.file.model_dump(mode="json")
+        suite.pop("splits")  # tuning seeds: they define no run of the comparison
+        doc = {"suite": suite, "quick": self.quick, "skipped": list(self._skipped)}
         return hashlib.sha256(json.dumps(doc, sort_keys=True, default=str).encode()).hexdigest()
 
     def settings(self) -> dict[str, Any]:
