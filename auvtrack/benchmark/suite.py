@@ -39,7 +39,7 @@ from ..scenario.errors import ScenarioError, translate
 
 __all__ = ["SuiteError", "SuiteFile", "Suite", "Task", "Tier", "Start", "ControllerEntry", "load_suite",
            "available_suites", "CRITERIA", "METRICS", "tracking_kinds", "check_competitor", "resolve_controllers",
-           "start_state", "DEFAULT_SUITE", "SPLITS", "Split", "Splits"]
+           "start_state", "DEFAULT_SUITE", "SPLITS", "Split", "Splits", "RunScore"]
 
 DEFAULT_SUITE = "auv-track-v1"
 METRICS: tuple[str, ...] = ("rmse", "itae", "max_error", "settling", "energy", "tv")
@@ -194,6 +194,31 @@ class Scoring(_Model):
         return {c: float(getattr(self, c)) for c in CRITERIA}
 
 
+class RunScore(_Model):
+    """``[run_score]``: the score of one run (:mod:`auvtrack.benchmark.scoring`), what tuning minimises."""
+
+    cap: Annotated[Num, Field(gt=0, le=1e6)] = 10.0
+    weights: dict[str, NonNeg] = Field(default_factory=dict, description="criterion -> weight")
+    scales: dict[str, Pos] = Field(default_factory=dict, description="criterion -> the value that scores 1")
+
+    @model_validator(mode="after")
+    def _criteria(self) -> "RunScore":
+        from ..metrics import METRIC_NAMES
+
+        known = set(METRICS) | set(METRIC_NAMES)
+        for section in ("weights", "scales"):
+            for c in getattr(self, section):
+                if c not in known:
+                    raise ValueError(f"{section}.{c}: not a criterion (one of the benchmark's metrics "
+                                     f"{', '.join(METRICS)} or an engine metric, docs/metrics.md)")
+        for c, w in self.weights.items():
+            if w > 0 and c not in self.scales:
+                raise ValueError(f"scales.{c}: missing (the value of {c} that scores 1, in its unit)")
+            if w != 0 and not MIN_WEIGHT <= w <= MAX_WEIGHT:
+                raise ValueError(f"weights.{c}: must be 0 or in [{MIN_WEIGHT:g}, {MAX_WEIGHT:g}] (got {w:g})")
+        return self
+
+
 class Quick(_Model):
     """``[quick]``: the CI-sized variant (every controller, task and tier)."""
 
@@ -262,6 +287,7 @@ class SuiteFile(_Model):
     tasks: Annotated[dict[str, Task], Field(min_length=1)]
     tiers: Annotated[dict[str, Tier], Field(min_length=1)]
     splits: Splits = Field(default_factory=Splits)
+    run_score: RunScore = Field(default_factory=RunScore)
 
     @model_validator(mode="after")
     def _names(self) -> "SuiteFile":
@@ -641,6 +667,35 @@ class Suite:
             if sp is not None and sp.seeds[0] <= index < sp.seeds[1]:
                 return name
         return None
+
+    def run_score(self, values: Mapping[str, Any], task: str) -> float:
+        """The score of one run of ``task`` under the suite's ``[run_score]`` (:mod:`~auvtrack.benchmark.scoring`).
+
+        Parameters
+        ----------
+        values : mapping
+            The run's ``status``, ``t_stop`` and criteria (a row of the runs table after
+            :func:`~auvtrack.benchmark.leaderboard.derive_metrics`).
+        task : str
+            Its task (for the duration: this variant's).
+
+        Returns
+        -------
+        float
+            Lower is better; every failed run above every completed one.
+
+        Raises
+        ------
+        SuiteError
+            The suite gives no criterion a weight.
+        """
+        from .scoring import run_score
+
+        rs = self.file.run_score
+        if not any(w > 0 for w in rs.weights.values()):
+            raise SuiteError(f"{self.source}: run_score.weights: no criterion has a weight > 0 (the per-run score "
+                             "that tuning minimises; docs/benchmark.md)")
+        return run_score(values, rs.weights, rs.scales, cap=rs.cap, duration=self.duration(task))
 
     def quick_variant(self) -> "Suite":
         """The ``--quick`` suite: every task and tier, few seeds, short runs."""
