@@ -639,7 +639,7 @@ BENCH = ROOT / "benchmarks" / "results.json"
 
 
 PERF_TARGETS = {"fxtntsmc_cpu_us": 2.0, "simd_efficiency": 2.5, "cold_run_s": 20.0, "cold_warmup_s": 90.0}
-"""Issue 15's targets, each used once for the text and once for the verdict."""
+"""The performance targets the README states, each used once for the text and once for the verdict."""
 
 
 def _met(ok: bool) -> str:

@@ -31,13 +31,13 @@ def block_gain_design() -> str:
 
     lines = [f"e_ref = {fmt(design.DESIGN_ERROR, 3)} m, kappa = {fmt(design.REACH_FRACTION, 3)}; peak demands of the "
              "defaults from e_ref (D3): " + ", ".join(f"{k} {fmt(design.peak_demand(k), 4)} m/s²"
-                                                      for k in design.DESIGNED) + ".", "",
+                                                      for k in design.designed_kinds()) + ".", "",
              "| design vehicle | U0 (m/s) | reach τ_u / τ_q / τ_r (N, N m, N m) | A (m/s²) | law | ω | designed gains |",
              "|---|---|---|---|---|---|---|"]
     for name, u0 in CASES:
         pre = get_preset(name, u0=u0)
         head = (f"`{name}`", fmt(pre.u0, 4), " / ".join(fmt(r, 4) for r in pre.reach))
-        for i, kind in enumerate(design.DESIGNED):
+        for i, kind in enumerate(design.designed_kinds()):
             d = design.design(kind, pre.m, pre.l, pre.reach)
             gains = ", ".join(f"{k} {fmt(v, 4)}" for k, v in d.gains.items() if k != "saturation")
             cells = head + (fmt(d.accel, 4),) if i == 0 else ("", "", "", "")

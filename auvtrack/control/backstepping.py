@@ -53,6 +53,8 @@ from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "backstepping"
 AUX_NAMES = ("z2_x", "z2_y", "z2_z", "b_hat_x", "b_hat_y", "b_hat_z")
+TIME_EXPONENTS = {"c1": 1, "c2": 1, "k0": 2, "gamma": 2, "sigma": 1, "kaw": 1}
+"""Gain -> its time dimension n (units s^-n): the gain design scales g by omega^n (control/design.py, D1)."""
 GAINS = packed_layout("BacksteppingGains", c1=1, c2=1, gamma=1, sigma=1, k0=1, kaw=1, saturation=1)
 
 
@@ -125,3 +127,28 @@ def setup(params: Params, ctx) -> CompiledController:
     gam = p.gamma if p.adaptive else 0.0
     cp = GAINS.pack(c1=p.c1, c2=p.c2, gamma=gam, sigma=p.sigma, k0=p.k0, kaw=p.kaw, saturation=code(p.saturation))
     return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES)
+
+
+def nominal_axis(p: Params, axis_index: int, e0: float):
+    """One axis of the nominal closed loop (B1)-(B4) from e(0) = e0 at rest, for the gain design's peak demand.
+
+    Parameters
+    ----------
+    p : Params
+        The gains.
+    axis_index : int
+        0, 1, 2 (x, y, z; the gains are shared by the axes).
+    e0 : float
+        Initial error, m.
+
+    Returns
+    -------
+    (callable, list)
+        ``f(t, x) -> (x_dot, a)`` over x = (e, e_dot, b_hat), and x(0).
+    """
+    gam = p.gamma if p.adaptive else 0.0
+
+    def f(t, x):
+        _, a, db = axis(x[0], x[1], x[2], p.c1, p.c2, gam, p.sigma, p.k0)
+        return np.array([x[1], a, db]), a
+    return f, [e0, 0.0, 0.0]

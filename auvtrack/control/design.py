@@ -33,11 +33,9 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
 
 import numpy as np
 
-from . import backstepping, ftsmc, fxtntsmc, pid, ppc, sta
 
 DESIGN_ERROR = 0.25
 """e_ref of (D3), m: the error the loop should meet without asking more than the reach (half the
@@ -53,20 +51,34 @@ PEAK_HORIZON = 40.0
 PEAK_DT = 0.01
 """s: its RK4 step."""
 
-TIME_EXPONENTS: dict[str, dict[str, float | Callable[[Any], float]]] = {
-    "pid": {"kp": 2, "ki": 3, "kd": 1, "kaw": 1},
-    "backstepping": {"c1": 1, "c2": 1, "k0": 2, "gamma": 2, "sigma": 1, "kaw": 1},
-    "sta": {"lam": 1, "k1": 1.5, "k2": 3, "L": 3, "kaw": 1},
-    "ftsmc": {"beta": lambda p: -p.gamma, "k1": 2, "k2": 2},
-    "ppc": {"kp": 2, "kd": 1, "l": 1, "k_aux": 1},
-}
-"""Per designed law, gain -> its time dimension n (units s^-n); a callable gives it from the defaults."""
-DESIGNED = tuple(TIME_EXPONENTS)
-"""The laws whose gains the rule sizes."""
-COMPENSATED_DEFAULT = DESIGNED + ("fxtntsmc",)
-"""The laws that take ``saturation = "compensated"`` on a vehicle with a reach."""
 
-_MODULES = {m.NAME: m for m in (pid, backstepping, sta, ftsmc, ppc, fxtntsmc)}
+
+def _spec(kind: str):
+    from . import CONTROLLERS
+    return CONTROLLERS[kind]
+
+
+def designed(kind: str) -> bool:
+    """Whether the rule sizes the gains of ``kind`` (its module declares ``TIME_EXPONENTS``)."""
+    return _spec(kind).time_exponents is not None
+
+
+def designable(kind: str) -> bool:
+    """Whether a vehicle with a reach changes the defaults of ``kind``: designed gains or a saturation form."""
+    spec = _spec(kind)
+    return spec.time_exponents is not None or spec.has_saturation_forms
+
+
+def designed_kinds() -> list[str]:
+    """The registered laws whose gains the rule sizes, in registration order."""
+    from . import CONTROLLERS
+    return [k for k in CONTROLLERS if designed(k)]
+
+
+def designable_kinds() -> list[str]:
+    """The registered laws a vehicle with a reach changes (:func:`designable`), in registration order."""
+    from . import CONTROLLERS
+    return [k for k in CONTROLLERS if designable(k)]
 
 
 @dataclass(frozen=True)
@@ -133,41 +145,6 @@ def _rk4_peak(f, x0: np.ndarray) -> float:
     return peak
 
 
-def _axis_dynamics(kind: str, p, axis: int):
-    """(f, x0) of one axis of the unscaled nominal closed loop, e_ddot = a, from the law's own per-axis function."""
-    e0 = DESIGN_ERROR
-    if kind == "pid":
-        def f(t, x):
-            a = pid.axis(x[0], x[1], x[2], p.kp, p.ki, p.kd)
-            return np.array([x[1], a, x[0] if p.ki > 0 else 0.0]), a
-        return f, [e0, 0.0, 0.0]
-    if kind == "backstepping":
-        gam = p.gamma if p.adaptive else 0.0
-        def f(t, x):
-            _, a, db = backstepping.axis(x[0], x[1], x[2], p.c1, p.c2, gam, p.sigma, p.k0)
-            return np.array([x[1], a, db]), a
-        return f, [e0, 0.0, 0.0]
-    if kind == "sta":
-        def f(t, x):
-            _, a, dv = sta.axis(x[0], x[1], x[2], p.lam, p.k1, p.k2)
-            return np.array([x[1], a, dv]), a
-        return f, [e0, 0.0, 0.0]
-    if kind == "ftsmc":
-        def f(t, x):
-            _, a = ftsmc.reaching(x[0], x[1], p.beta, p.gamma, p.k1, p.k2)
-            return np.array([x[1], a]), a
-        return f, [e0, 0.0]
-    if kind == "ppc":
-        def f(t, x):
-            r = ppc.envelope(t, p.rho0[axis], p.rho_inf[axis], p.l)
-            status, _, a = ppc.axis(x[0], x[1], r[0], r[1], r[2], p.kp, p.kd)
-            if status != 0:
-                raise ValueError(f"controller.rho0: e_ref = {e0} m leaves the PPC envelope on axis {axis}")
-            return np.array([x[1], a]), a
-        return f, [e0, 0.0]
-    raise KeyError(f"no gain design for controller kind {kind!r}; designed: {', '.join(DESIGNED)}")
-
-
 @functools.lru_cache(maxsize=None)
 def peak_demand(kind: str) -> float:
     """a_pk of (D3) for a law's defaults: the largest |e_ddot| its nominal closed loop demands, m/s^2.
@@ -175,16 +152,16 @@ def peak_demand(kind: str) -> float:
     Parameters
     ----------
     kind : str
-        One of :data:`DESIGNED`.
+        A law with a design (:func:`designed`).
 
     Returns
     -------
     float
-        The peak over the three axes (they differ only for the PPC, whose rho0 is per axis).
+        The peak over the three axes (they differ where a law's parameters are per axis).
     """
-    p = _MODULES[kind].Params()
-    axes = (0, 1, 2) if kind == "ppc" else (0,)
-    return max(_rk4_peak(*_axis_dynamics(kind, p, i)) for i in axes)
+    spec = _spec(kind)
+    p = spec.params()
+    return max(_rk4_peak(*spec.nominal_axis(p, i, DESIGN_ERROR)) for i in range(3))
 
 
 def scaled_gains(kind: str, omega: float) -> dict:
@@ -193,18 +170,19 @@ def scaled_gains(kind: str, omega: float) -> dict:
     Parameters
     ----------
     kind : str
-        One of :data:`DESIGNED`.
+        A law with a design (:func:`designed`).
     omega : float
         The time scale (> 0).
 
     Returns
     -------
     dict
-        Field -> value for every gain of :data:`TIME_EXPONENTS` ``[kind]``.
+        Field -> value for every gain of the law's ``TIME_EXPONENTS``.
     """
-    p = _MODULES[kind].Params()
+    spec = _spec(kind)
+    p = spec.params()
     out = {}
-    for name, n in TIME_EXPONENTS[kind].items():
+    for name, n in spec.time_exponents.items():
         power = n(p) if callable(n) else n
         out[name] = float(getattr(p, name)) * omega ** power
     return out
@@ -216,7 +194,8 @@ def design(kind: str, m, ell: float, reach) -> GainDesign:
     Parameters
     ----------
     kind : str
-        One of :data:`COMPENSATED_DEFAULT` (the FXTNTSMC gets only its saturation form).
+        A law that :func:`designable` accepts (one with only a saturation form, like the FXTNTSMC,
+        gets only that form).
     m : sequence of 5 float
         The design model's inertias (kg, kg m^2).
     ell : float
@@ -234,12 +213,12 @@ def design(kind: str, m, ell: float, reach) -> GainDesign:
     ValueError
         A reach that is not positive on the pitch and yaw axes (one line naming it).
     """
-    sat = {"saturation": "compensated"} if "saturation" in _MODULES[kind].Params.model_fields else {}
+    sat = {"saturation": "compensated"} if _spec(kind).has_saturation_forms else {}
     accel = reach_acceleration(m, ell, reach)
     if not (accel > 0.0 and math.isfinite(accel)):
         raise ValueError(f"vehicle: the fins' reach at cruise speed must be > 0 on pitch and yaw to design gains "
                          f"(got {list(reach)})")
-    if kind not in DESIGNED:
+    if not designed(kind):
         return GainDesign(kind, accel, math.nan, 1.0, sat)
     peak = peak_demand(kind)
     omega = min(1.0, math.sqrt(REACH_FRACTION * accel / peak))

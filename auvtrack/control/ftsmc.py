@@ -27,6 +27,8 @@ from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
 
 NAME = "ftsmc"
 AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z")
+TIME_EXPONENTS = {"beta": lambda p: -p.gamma, "k1": 2, "k2": 2}
+"""Gain -> its time dimension n (units s^-n; beta's from gamma): the gain design scales g by omega^n (control/design.py, D1)."""
 GAINS = packed_layout("FTSMCGains", beta=1, gamma=1, k1=1, k2=1)
 
 
@@ -76,3 +78,26 @@ def setup(params: Params, ctx) -> CompiledController:
     p = params
     cp = GAINS.pack(beta=p.beta, gamma=p.gamma, k1=p.k1, k2=p.k2)
     return CompiledController(cp=cp, xc0=np.zeros(0), aux_names=AUX_NAMES)
+
+
+def nominal_axis(p: Params, axis_index: int, e0: float):
+    """One axis of the nominal closed loop (the reaching law) from e(0) = e0 at rest, for the gain design's peak demand.
+
+    Parameters
+    ----------
+    p : Params
+        The gains.
+    axis_index : int
+        0, 1, 2 (x, y, z; the gains are shared by the axes).
+    e0 : float
+        Initial error, m.
+
+    Returns
+    -------
+    (callable, list)
+        ``f(t, x) -> (x_dot, a)`` over x = (e, e_dot), and x(0).
+    """
+    def f(t, x):
+        _, a = reaching(x[0], x[1], p.beta, p.gamma, p.k1, p.k2)
+        return np.array([x[1], a]), a
+    return f, [e0, 0.0]

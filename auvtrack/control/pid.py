@@ -39,6 +39,8 @@ from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "pid"
 AUX_NAMES = ("I_x", "I_y", "I_z")
+TIME_EXPONENTS = {"kp": 2, "ki": 3, "kd": 1, "kaw": 1}
+"""Gain -> its time dimension n (units s^-n): the gain design scales g by omega^n (control/design.py, D1)."""
 GAINS = packed_layout("PIDGains", kp=1, ki=1, kd=1, kaw_ki=1, saturation=1)
 
 
@@ -119,3 +121,26 @@ def setup(params: Params, ctx) -> CompiledController:
     poles = np.roots([1.0, p.kd, p.kp, p.ki] if p.ki > 0 else [1.0, p.kd, p.kp])  # of eq. (P3)
     return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES, notes=notes,
                               resolved={"error_poles": [[float(z.real), float(z.imag)] for z in poles]})
+
+
+def nominal_axis(p: Params, axis_index: int, e0: float):
+    """One axis of the nominal closed loop e_ddot = a (P1) from e(0) = e0 at rest, for the gain design's peak demand.
+
+    Parameters
+    ----------
+    p : Params
+        The gains.
+    axis_index : int
+        0, 1, 2 (x, y, z; the PID's gains are shared by the axes).
+    e0 : float
+        Initial error, m.
+
+    Returns
+    -------
+    (callable, list)
+        ``f(t, x) -> (x_dot, a)`` over x = (e, e_dot, integral of e), and x(0).
+    """
+    def f(t, x):
+        a = axis(x[0], x[1], x[2], p.kp, p.ki, p.kd)
+        return np.array([x[1], a, x[0] if p.ki > 0 else 0.0]), a
+    return f, [e0, 0.0, 0.0]

@@ -62,6 +62,9 @@ from .tracking import error_state_forces, input_for_accel_forces
 
 NAME = "ppc"
 AUX_NAMES = ("rho_x", "rho_y", "rho_z", "eps_x", "eps_y", "eps_z")
+TIME_EXPONENTS = {"kp": 2, "kd": 1, "l": 1, "k_aux": 1}
+"""Gain -> its time dimension n (units s^-n; the envelope rho0, rho_inf is kept): the gain design scales g by
+omega^n (control/design.py, D1)."""
 COMPENSATION_NAMES = ("sat_comp_x", "sat_comp_y", "sat_comp_z")
 """Channels added when compensated: lam of (R5), m."""
 GAINS = packed_layout("PPCGains", kp=1, kd=1, l=1, rho0=3, rho_inf=3, k_aux=1, saturation=1)
@@ -189,3 +192,34 @@ def setup(params: Params, ctx) -> CompiledController:
     comp = p.saturation == "compensated"
     return CompiledController(cp=cp, xc0=np.zeros(6 if comp else 0),
                               aux_names=AUX_NAMES + (COMPENSATION_NAMES if comp else ()), resolved={"xi0": xi0})
+
+
+def nominal_axis(p: Params, axis_index: int, e0: float):
+    """One axis of the nominal closed loop (R1)-(R4) from e(0) = e0 at rest, for the gain design's peak demand.
+
+    Parameters
+    ----------
+    p : Params
+        The gains.
+    axis_index : int
+        0, 1, 2 (x, y, z: the envelope rho0, rho_inf is per axis).
+    e0 : float
+        Initial error, m.
+
+    Returns
+    -------
+    (callable, list)
+        ``f(t, x) -> (x_dot, a)`` over x = (e, e_dot), and x(0).
+
+    Raises
+    ------
+    ValueError
+        ``e0`` leaves the envelope.
+    """
+    def f(t, x):
+        r = envelope(t, p.rho0[axis_index], p.rho_inf[axis_index], p.l)
+        status, _, a = axis(x[0], x[1], r[0], r[1], r[2], p.kp, p.kd)
+        if status != 0:
+            raise ValueError(f"controller.rho0: e_ref = {e0} m leaves the PPC envelope on axis {axis_index}")
+        return np.array([x[1], a]), a
+    return f, [e0, 0.0]

@@ -229,6 +229,11 @@ class ControllerSpec:
         ``warnings(params) -> list[str]`` for ``auvtrack check``.
     aux_names : tuple of str
         Its logged channels.
+    time_exponents : dict or None
+        Gain -> its time dimension n (units s^-n; a callable gives it from the defaults) when the
+        law's default gains can be designed for a vehicle (:mod:`auvtrack.control.design`).
+    nominal_axis : callable or None
+        ``nominal_axis(params, axis, e0) -> (f, x0)``: one axis of its nominal closed loop, for the design.
     """
 
     name: str
@@ -243,6 +248,13 @@ class ControllerSpec:
     sections: tuple[str, ...] = ()
     warnings: Callable[[Any], list[str]] | None = None
     aux_names: tuple[str, ...] = ()
+    time_exponents: dict[str, Any] | None = None
+    nominal_axis: Callable[..., Any] | None = None
+
+    @property
+    def has_saturation_forms(self) -> bool:
+        """Whether its ``Params`` has a ``saturation`` field (published or compensated forms)."""
+        return "saturation" in self.params.model_fields
 
     def runs_on(self, plant) -> bool:
         """Whether this controller can fly ``plant`` (a :class:`~auvtrack.plant.registry.PlantSpec`).
@@ -399,10 +411,32 @@ def check_controller(module: ModuleType, *, plugin: bool = False) -> ControllerS
     warn = getattr(module, "warnings", None)
     if warn is not None and not callable(warn):
         raise ValueError(f"{where}: warnings must be a function warnings(params) -> list of str")
+    exponents, nominal = _gain_design(module, where)
     doc = (module.__doc__ or "").strip()
     return ControllerSpec(name, module.__name__, module.Params, module.setup, doc.splitlines()[0] if doc else "",
                           {int(k): str(v) for k, v in status.items()}, commands, tracks, plants, sections, warn,
-                          tuple(module.AUX_NAMES))
+                          tuple(module.AUX_NAMES), exponents, nominal)
+
+
+def _gain_design(module: ModuleType, where: str) -> tuple[dict | None, Callable | None]:
+    """A module's gain-design declaration: ``TIME_EXPONENTS`` (gain -> number or callable) with ``nominal_axis``."""
+    exponents = getattr(module, "TIME_EXPONENTS", None)
+    nominal = getattr(module, "nominal_axis", None)
+    if exponents is None and nominal is None:
+        return None, None
+    if exponents is None or not callable(nominal):
+        raise ValueError(f"{where}: a law whose gains can be designed defines both TIME_EXPONENTS and "
+                         f"nominal_axis(params, axis, e0) (docs/controllers.md, \"Gains designed for the vehicle\")")
+    fields = module.Params.model_fields
+    if not isinstance(exponents, Mapping) or not exponents:
+        raise ValueError(f"{where}: TIME_EXPONENTS must map gain names to their time dimension (got {exponents!r})")
+    for k, n in exponents.items():
+        if k not in fields:
+            raise ValueError(f"{where}: TIME_EXPONENTS.{k}: not a field of Params")
+        if not (callable(n) or (isinstance(n, (int, float)) and not isinstance(n, bool) and math.isfinite(n))):
+            raise ValueError(f"{where}: TIME_EXPONENTS.{k}: must be a finite number or a function of the "
+                             f"defaults (got {n!r})")
+    return dict(exponents), nominal
 
 
 CONTROLLERS: dict[str, ControllerSpec] = {}

@@ -55,6 +55,8 @@ from .tracking import error_state_forces, input_for_accel_forces, sign
 
 NAME = "sta"
 AUX_NAMES = ("sliding_x", "sliding_y", "sliding_z", "integral_x", "integral_y", "integral_z")  # s and v
+TIME_EXPONENTS = {"lam": 1, "k1": 1.5, "k2": 3, "L": 3, "kaw": 1}
+"""Gain -> its time dimension n (units s^-n): the gain design scales g by omega^n (control/design.py, D1)."""
 GAINS = packed_layout("STAGains", lam=1, k1=1, k2=1, kaw=1, saturation=1)
 
 
@@ -150,3 +152,26 @@ def setup(params: Params, ctx) -> CompiledController:
     return CompiledController(cp=cp, xc0=np.zeros(3), aux_names=AUX_NAMES,
                               resolved={"levant_k1_min": levant_k1_min(p.k2, p.L) if p.k2 > p.L else None,
                                         "moreno_osorio_k2_min": moreno_osorio_k2_min(p.k1, p.L)})
+
+
+def nominal_axis(p: Params, axis_index: int, e0: float):
+    """One axis of the nominal closed loop (S1)-(S7) from e(0) = e0 at rest, for the gain design's peak demand.
+
+    Parameters
+    ----------
+    p : Params
+        The gains.
+    axis_index : int
+        0, 1, 2 (x, y, z; the gains are shared by the axes).
+    e0 : float
+        Initial error, m.
+
+    Returns
+    -------
+    (callable, list)
+        ``f(t, x) -> (x_dot, a)`` over x = (e, e_dot, v), and x(0).
+    """
+    def f(t, x):
+        _, a, dv = axis(x[0], x[1], x[2], p.lam, p.k1, p.k2)
+        return np.array([x[1], a, dv]), a
+    return f, [e0, 0.0, 0.0]

@@ -48,7 +48,9 @@ def gain_design(kind: str, vehicle: Mapping[str, Any]) -> design.GainDesign | No
         None when the law has no design or the vehicle no reach (or the section is invalid: its
         own validator reports that).
     """
-    if kind not in design.COMPENSATED_DEFAULT:
+    from ..control import CONTROLLERS
+
+    if kind not in CONTROLLERS or not design.designable(kind):
         return None
     try:
         pre = get_preset(vehicle.get("preset", "paper"), u0=vehicle.get("u0"))
@@ -99,7 +101,7 @@ def designed_controller(data: Mapping[str, Any], default_kind: str) -> Mapping[s
     found = gain_design(kind, vehicle) if isinstance(kind, str) and isinstance(vehicle, Mapping) else None
     if found is None:
         if preset == DESIGNED:
-            raise ValueError(f"controller.preset: \"designed\" needs a law with a design ({', '.join(design.COMPENSATED_DEFAULT)}) "
+            raise ValueError(f"controller.preset: \"designed\" needs a law with a design ({', '.join(design.designable_kinds())}) "
                              f"and a design vehicle with a known actuator reach (vehicle.preset = \"remus100\" or a vehicle "
                              f"file) (got kind {kind!r}, vehicle.preset {vehicle.get('preset', 'paper')!r})")
         return {**data, "controller": rest} if preset is not None else data

@@ -74,9 +74,9 @@ GAINS = ("designed", "published")
 
 
 def controllers() -> list[str]:
-    """Tracking controllers to compare: every built-in kind except the open-loop ones (and plug-ins)."""
-    from ..control import BUILTIN
-    return [m.NAME for m in BUILTIN if not m.NAME.startswith("open_loop")]
+    """Tracking controllers to compare: every built-in whose registration says it tracks (no plug-ins)."""
+    from ..benchmark.suite import tracking_kinds
+    return tracking_kinds()
 
 
 def start_pose(ref_spec: dict, ell: float = ELL) -> tuple[list[float], list[float]]:
@@ -139,10 +139,12 @@ def scenario(controller: str, truth: str, reference: str, current: bool, duratio
 
 
 def gain_sets(controller: str) -> tuple[str, ...]:
-    """The gain sets of :data:`GAINS` that differ for ``controller`` (``published`` only when its
-    defaults are designed or it has a published saturation form)."""
-    from ..control.design import COMPENSATED_DEFAULT
-    return GAINS if controller in COMPENSATED_DEFAULT else GAINS[:1]
+    """The gain sets of :data:`GAINS` that differ for ``controller``.
+
+    ``published`` only when its defaults are designed or it has a published saturation form.
+    """
+    from ..control.design import designable
+    return GAINS if designable(controller) else GAINS[:1]
 
 
 def jobs(quick: bool) -> list[tuple]:

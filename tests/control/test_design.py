@@ -20,7 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from auvtrack.cli import EXIT_BAD_INPUT, main
-from auvtrack.control import backstepping, design, ftsmc, pid, ppc, sta
+from auvtrack.control import CONTROLLERS, backstepping, design, ftsmc, pid, ppc, sta
 from auvtrack.scenario import load_scenario
 from auvtrack.vehicle.presets import get_preset
 from auvtrack.vehicle.truth_presets import load_preset6
@@ -30,7 +30,7 @@ MODULES = {m.NAME: m for m in (pid, backstepping, sta, ftsmc, ppc)}
 
 def _trajectory(kind, params, h, n):
     """(e, a) of the nominal closed loop of one axis (the design module's dynamics), RK4 step h, n steps."""
-    f, x0 = design._axis_dynamics(kind, params, 1)
+    f, x0 = CONTROLLERS[kind].nominal_axis(params, 1, design.DESIGN_ERROR)
     x, t, es, acc = np.array(x0, float), 0.0, [], []
     for _ in range(n):
         k1, a = f(t, x)
@@ -44,7 +44,7 @@ def _trajectory(kind, params, h, n):
 
 
 @settings(max_examples=8)
-@given(st.sampled_from(design.DESIGNED), st.floats(0.2, 0.9))
+@given(st.sampled_from(design.designed_kinds()), st.floats(0.2, 0.9))
 def test_scaled_gains_scale_the_closed_loop_in_time(kind, omega):
     """e_omega(t) = e_1(omega t) and a_omega = omega^2 a_1 (D1), on the grid t = k h / omega."""
     h, n = 0.01, 1500
@@ -72,7 +72,7 @@ def test_peak_demand_of_the_defaults_is_their_demand_at_the_start():
         assert design.peak_demand("ppc") >= abs(ppc.axis(e, 0.0, r[0], r[1], r[2], q.kp, q.kd)[2])
 
 
-@pytest.mark.parametrize("kind", design.DESIGNED)
+@pytest.mark.parametrize("kind", design.designed_kinds())
 def test_designed_demand_is_the_reach_and_the_defaults_cap_it(kind):
     m, ell = (30.0, 60.0, 60.0, 8.0, 9.0), 1.2
     small = design.design(kind, m, ell, (4.0, 1.0, 1.5))
@@ -83,7 +83,7 @@ def test_designed_demand_is_the_reach_and_the_defaults_cap_it(kind):
     big = design.design(kind, m, ell, (4.0, 2e4, 3e4))
     assert big.omega == 1.0
     defaults = MODULES[kind].Params()
-    assert all(big.gains[k] == getattr(defaults, k) for k in design.TIME_EXPONENTS[kind])
+    assert all(big.gains[k] == getattr(defaults, k) for k in CONTROLLERS[kind].time_exponents)
     assert ("saturation" in small.gains) == ("saturation" in MODULES[kind].Params.model_fields)
 
 
@@ -188,3 +188,26 @@ def test_generated_design_table_in_docs_controllers_md_is_current():
     names = [m.group("name") for m in gain_design.BLOCK_RE.finditer(text) if m.group("name") in gain_design.blocks()]
     assert names == ["gain-design"]
     assert gain_design.render_text(text) == text, "stale: python -m tools.gain_design render"
+
+
+def test_a_gain_design_is_declared_by_the_law_and_checked_at_registration(tmp_path):
+    """The design reads each law's own declaration; a wrong one is one line naming the file."""
+    from auvtrack.control.registry import check_controller
+
+    assert set(design.designed_kinds()) == {"pid", "backstepping", "sta", "ftsmc", "ppc"}
+    assert "fxtntsmc" in design.designable_kinds() and "fxtntsmc" not in design.designed_kinds()
+    assert "los_autopilot" not in design.designable_kinds()
+
+    class Fake:
+        pass
+
+    for bad, expect in ((dict(TIME_EXPONENTS={"kq": 2}), "TIME_EXPONENTS.kq: not a field"),
+                        (dict(TIME_EXPONENTS={"kp": "two"}), "TIME_EXPONENTS.kp: must be a finite number"),
+                        (dict(nominal_axis=None, TIME_EXPONENTS={"kp": 2}), "defines both TIME_EXPONENTS")):
+        mod = type(pid)("fake_pid")
+        mod.__dict__.update({k: getattr(pid, k) for k in dir(pid) if not k.startswith("__")})
+        mod.__file__ = str(tmp_path / "fake_pid.py")
+        for k, v in bad.items():
+            setattr(mod, k, v)
+        with pytest.raises(ValueError, match=expect):
+            check_controller(mod)
