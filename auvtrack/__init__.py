@@ -5,7 +5,7 @@ or a :class:`~auvtrack.scenario.Scenario`) and returns a :class:`~auvtrack.simul
 """
 from __future__ import annotations
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = ["__version__", "simulate", "load_scenario", "Result"]
 

@@ -26,7 +26,7 @@ from typing import Any, Callable
 from .._atomic import atomic_write
 from .chunk_files import chunk_path
 from .executor import ChunkJob, check_workers, execute_chunks
-from .sweep_spec import StudyError, StudySpec, load_study
+from .sweep_spec import StudyError, SweepSpec, load_study
 
 MANIFEST = "study.json"
 RESULTS = "results.parquet"
@@ -69,7 +69,7 @@ class SweepJob(ChunkJob):
 
     Parameters
     ----------
-    spec : StudySpec
+    spec : SweepSpec
         The loaded study.
     """
 
@@ -81,7 +81,7 @@ class SweepJob(ChunkJob):
     lost_hint = " (out of memory? see --worker-memory)"
     error = StudyError
 
-    def __init__(self, spec: StudySpec) -> None:
+    def __init__(self, spec: SweepSpec) -> None:
         self.spec = spec
 
     @property
@@ -207,7 +207,7 @@ def _client(workers: int | None, scheduler: str | None, memory_limit: str | int)
     return client, cluster
 
 
-def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | None = None,
+def run_sweep(study: str | Path | SweepSpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False, max_chunks: int | None = None,
               progress: bool = True, client: Any = None, memory_limit: str | int = DEFAULT_WORKER_MEMORY,
               on_chunk: Callable[[int, Any], None] | None = None) -> SweepOutcome:
@@ -215,7 +215,7 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
 
     Parameters
     ----------
-    study : str, Path or StudySpec
+    study : str, Path or SweepSpec
         Study file or a loaded study.
     out : str or Path
         Output folder: ``study.json``, ``chunks/``, ``results.parquet``, ``summary.{json,md}``.
@@ -253,7 +253,7 @@ def run_sweep(study: str | Path | StudySpec, out: str | Path, *, workers: int | 
         Invalid study file, an output folder holding another study or other files, a
         ``--scheduler`` address where no Dask scheduler answers, or a cluster that lost every worker.
     """
-    spec = study if isinstance(study, StudySpec) else load_study(study)
+    spec = study if isinstance(study, SweepSpec) else load_study(study)
     check_workers(workers, StudyError)
     parse_memory(memory_limit)
     cluster = None if client is not None or scheduler else (lambda: _client(workers, None, memory_limit))
@@ -284,7 +284,7 @@ def _finite_or_none(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def group_keys(spec: StudySpec) -> list[str]:
+def group_keys(spec: SweepSpec) -> list[str]:
     """Grid keys whose values are names (``controller.kind``, ``vehicle.preset``...): one summary each.
 
     Pooling the metrics of different controllers or vehicles gives quantiles of neither, so the
@@ -318,7 +318,7 @@ def _stats(status, cause, columns: dict, mask) -> dict:
             "invalid_rate": counts.get("invalid", 0) / n if n else math.nan, "causes": causes, "metrics": metrics}
 
 
-def summarize(results: Path, spec: StudySpec) -> dict:
+def summarize(results: Path, spec: SweepSpec) -> dict:
     """Counts, failure rate, causes and per-metric quantiles (over "ok" samples) of a results file.
 
     The top level pools every sample; ``groups`` repeats the statistics for each combination of

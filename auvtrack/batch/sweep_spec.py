@@ -26,7 +26,7 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Field, Strict, Validat
 from ..scenario.errors import ScenarioError, format_value, one_line, translate
 from ..scenario.names import check_name
 
-__all__ = ["StudyError", "StudyFile", "StudyLimits", "StudySpec", "load_study", "PAPER_SCENARIO", "MAX_SAMPLES"]
+__all__ = ["StudyError", "StudyFile", "StudyLimits", "SweepSpec", "load_study", "PAPER_SCENARIO", "MAX_SAMPLES"]
 
 PAPER_SCENARIO = "paper"
 MAX_SAMPLES = 100_000_000
@@ -199,7 +199,7 @@ def _column_value(v: Any) -> Any:
 
 
 @dataclass(frozen=True)
-class StudySpec:
+class SweepSpec:
     """A loaded, validated study: everything a worker needs (plain data, picklable).
 
     Attributes
@@ -306,7 +306,7 @@ def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
         raise _fail(source, "set", str(exc)) from None
 
 
-def _problem(spec: StudySpec, overrides: dict) -> ValueError | None:
+def _problem(spec: SweepSpec, overrides: dict) -> ValueError | None:
     """Validate one sample as ``auvtrack check`` would (load, plan, controller set-up); the error or None."""
     import warnings
 
@@ -332,13 +332,13 @@ def _error_path(exc: ValueError) -> str:
     return m.group(1) if m else ""
 
 
-def _probe(spec: StudySpec, field: str, overrides: dict) -> None:
+def _probe(spec: SweepSpec, field: str, overrides: dict) -> None:
     exc = _problem(spec, overrides)
     if exc is not None:
         raise _fail(spec.source, field, f"the scenario rejects it: {one_line(str(exc))}") from None
 
 
-def check_against_scenario(spec: StudySpec) -> None:
+def check_against_scenario(spec: SweepSpec) -> None:
     """Validate the base scenario, every grid value and each random range as ``auvtrack check`` would.
 
     Each probe is loaded, planned (``[limits]``) and set up by its controller, so a grid value
@@ -368,7 +368,7 @@ def check_against_scenario(spec: StudySpec) -> None:
         _probe(spec, "seed_key", {**first, study.seed_key: spec.sample_seed(0)})
 
 
-def load_study(path: str | Path, *, check: bool = True) -> StudySpec:
+def load_study(path: str | Path, *, check: bool = True) -> SweepSpec:
     """Read and validate a study file.
 
     Parameters
@@ -381,7 +381,7 @@ def load_study(path: str | Path, *, check: bool = True) -> StudySpec:
 
     Returns
     -------
-    StudySpec
+    SweepSpec
 
     Raises
     ------
@@ -401,7 +401,7 @@ def load_study(path: str | Path, *, check: bool = True) -> StudySpec:
         err = translate(exc, StudyFile, source)
         text = re.sub(r"\.(?:uniform|normal|loguniform)(?=[.:])", "", str(err), count=1)  # union tag
         raise StudyError(text, err.path) from None
-    spec = StudySpec(study, _base_scenario(study, Path(path).resolve().parent, source), source)
+    spec = SweepSpec(study, _base_scenario(study, Path(path).resolve().parent, source), source)
     if check:
         check_against_scenario(spec)
     return spec

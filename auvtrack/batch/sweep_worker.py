@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .sweep_spec import StudySpec
+from .sweep_spec import SweepSpec
 
 STATUS_OK, STATUS_FAILED, STATUS_INVALID = "ok", "failed", "invalid"
 FIXED_COLUMNS = ("sample", "point", "replicate")
@@ -32,7 +32,7 @@ def _grid_type(values: list[Any]):
     return pa.string()
 
 
-def result_schema(spec: StudySpec):
+def result_schema(spec: SweepSpec):
     """Arrow schema of the results table of ``spec`` (identical for every chunk).
 
     Columns: sample, point, replicate, one per varied key (grid values as typed, non-scalar
@@ -79,7 +79,7 @@ def worker_memory_budget() -> int | None:
     return int(MEMORY_FRACTION * limit) - psutil.Process().memory_info().rss
 
 
-def _prepare_sample(spec: StudySpec, index: int, budget: int | None):
+def _prepare_sample(spec: SweepSpec, index: int, budget: int | None):
     """(seed, Prepared, or (status, cause, detail) of a sample that does not run)."""
     import warnings
 
@@ -104,12 +104,12 @@ def _prepare_sample(spec: StudySpec, index: int, budget: int | None):
         return seed, (STATUS_INVALID, "invalid", " ".join(str(exc).split()) or type(exc).__name__)
 
 
-def _base_row(spec: StudySpec, i: int, seed: int) -> dict[str, Any]:
+def _base_row(spec: SweepSpec, i: int, seed: int) -> dict[str, Any]:
     point, rep, _ = spec.sample(i)
     return {"sample": i, "point": point, "replicate": rep, **spec.column_values(i), "seed": seed}
 
 
-def _table(spec: StudySpec, rows: list[dict[str, Any]]):
+def _table(spec: SweepSpec, rows: list[dict[str, Any]]):
     import pyarrow as pa
 
     schema = result_schema(spec)
@@ -124,12 +124,12 @@ def _not_run(row: dict[str, Any], status: str, cause: str, detail: str) -> dict[
     return row
 
 
-def run_samples(spec: StudySpec, indices: list[int]):
+def run_samples(spec: SweepSpec, indices: list[int]):
     """Run the samples ``indices`` (metrics only) and return their rows as an Arrow table.
 
     Parameters
     ----------
-    spec : StudySpec
+    spec : SweepSpec
         The loaded study (plain data).
     indices : list of int
         Sample indices, in the order of the rows.
@@ -165,12 +165,12 @@ def run_samples(spec: StudySpec, indices: list[int]):
     return _table(spec, rows)
 
 
-def run_chunk(spec: StudySpec, chunk: int):
+def run_chunk(spec: SweepSpec, chunk: int):
     """Run the samples of chunk ``chunk`` (metrics only) and return their rows as an Arrow table.
 
     Parameters
     ----------
-    spec : StudySpec
+    spec : SweepSpec
         The loaded study (plain data).
     chunk : int
         Chunk index, ``0 <= chunk < spec.n_chunks``.
@@ -183,12 +183,12 @@ def run_chunk(spec: StudySpec, chunk: int):
     return run_samples(spec, list(spec.chunk_range(chunk)))
 
 
-def lost_rows(spec: StudySpec, indices: list[int], detail: str):
+def lost_rows(spec: SweepSpec, indices: list[int], detail: str):
     """Rows recording samples that could not be computed because their worker process died.
 
     Parameters
     ----------
-    spec : StudySpec
+    spec : SweepSpec
         The loaded study.
     indices : list of int
         The samples.

@@ -103,7 +103,7 @@ def config_label(env: str, est: str) -> str:
 
 
 @dataclass(frozen=True)
-class Settings:
+class AblationSettings:
     """Everything that defines a run of the study (``quick`` shrinks it).
 
     ``directions`` are (name, 5-vector) pairs; the horizon of a pulse run is
@@ -131,7 +131,7 @@ class Settings:
         return self.pulse_start + self.pulse_duration + self.recovery
 
     @classmethod
-    def quick(cls) -> "Settings":
+    def quick(cls) -> "AblationSettings":
         """CI-sized: FXTNTSMC with envelopes none, rigid and proactive and the default estimator;
         heave only, continuous control, a coarse grid and tolerance."""
         return cls(recovery=3.0, nominal_duration=20.0, a_min=10.0, a_max=1000.0, per_decade=3, rtol=0.5,
@@ -161,7 +161,7 @@ def parse_pulse(text: str) -> tuple[float, ...]:
 
 
 def settings_for(quick: bool = False, pulse: str | Sequence[float] | None = None,
-                 pulse_start: float | None = None) -> Settings:
+                 pulse_start: float | None = None) -> AblationSettings:
     """Default or quick settings with the ``--pulse`` / ``--pulse-start`` options applied.
 
     Raises
@@ -169,7 +169,7 @@ def settings_for(quick: bool = False, pulse: str | Sequence[float] | None = None
     ValueError
         For a bad ``pulse`` or a ``pulse_start`` that is not a finite number >= 0.
     """
-    st = Settings.quick() if quick else Settings()
+    st = AblationSettings.quick() if quick else AblationSettings()
     if pulse is not None:
         vec = parse_pulse(pulse) if isinstance(pulse, str) else parse_pulse(",".join(map(str, pulse)))
         st = replace(st, directions=((f"pulse [{', '.join(f'{v:g}' for v in vec)}]", vec),))
@@ -182,7 +182,7 @@ def settings_for(quick: bool = False, pulse: str | Sequence[float] | None = None
     return st
 
 
-def _check_horizon(st: Settings) -> None:
+def _check_horizon(st: AblationSettings) -> None:
     """Refuse a pulse onset whose runs the scenario would refuse (run plan, time grid), naming the option."""
     try:
         with warnings.catch_warnings():
@@ -359,7 +359,7 @@ def compare(a: dict[str, Any], b: dict[str, Any]) -> int:
 
 # ------------------------------------------------------------------ runs
 def _scenario(cfg: Config, condition: str, duration: float, pulse: tuple[float, ...] | None,
-              st: Settings, window: tuple[float, float] | None = None, log_dt: float | None = None):
+              st: AblationSettings, window: tuple[float, float] | None = None, log_dt: float | None = None):
     ov = [*cfg.overrides, *CONDITIONS[condition], f"sim.duration={duration:g}"]
     if window is not None:
         ov.append(f"metrics.window=[{window[0]:g}, {window[1]:g}]")
@@ -428,7 +428,7 @@ def _summary(res: Result, t_from: float = 0.0) -> dict[str, Any]:
     return out
 
 
-def _scan_job(job: tuple[Config, str, str, tuple[float, ...], Settings]) -> dict[str, Any]:
+def _scan_job(job: tuple[Config, str, str, tuple[float, ...], AblationSettings]) -> dict[str, Any]:
     cfg, condition, direction, vec, st = job
 
     def survives(a: float):
@@ -441,13 +441,13 @@ def _scan_job(job: tuple[Config, str, str, tuple[float, ...], Settings]) -> dict
     return {"config": cfg.label, "condition": condition, "direction": direction, **asdict(sv)}
 
 
-def _nominal_job(job: tuple[Config, str, Settings]) -> dict[str, Any]:
+def _nominal_job(job: tuple[Config, str, AblationSettings]) -> dict[str, Any]:
     cfg, condition, st = job
     res = _run(_scenario(cfg, condition, st.nominal_duration, None, st))
     return {"config": cfg.label, "condition": condition, **_summary(res)}
 
 
-def _reference_job(job: tuple[Config, str, str, tuple[float, ...], Settings]) -> dict[str, Any]:
+def _reference_job(job: tuple[Config, str, str, tuple[float, ...], AblationSettings]) -> dict[str, Any]:
     cfg, condition, direction, vec, st = job
     pulse = tuple(st.a_ref * x for x in vec)
     res = _run(_scenario(cfg, condition, st.horizon, pulse, st, window=(st.pulse_start, st.horizon)))
@@ -485,7 +485,7 @@ def intervals_text(r: dict[str, Any]) -> str:
                      for iv in r["intervals"])
 
 
-def _figure(scans: list[dict[str, Any]], st: Settings):
+def _figure(scans: list[dict[str, Any]], st: AblationSettings):
     from matplotlib.figure import Figure
 
     dirs = [d for d, _ in st.directions]
@@ -520,7 +520,7 @@ def _figure(scans: list[dict[str, Any]], st: Settings):
     return fig
 
 
-def _near_threshold(scans: list[dict[str, Any]], cfgs: list[Config], st: Settings):
+def _near_threshold(scans: list[dict[str, Any]], cfgs: list[Config], st: AblationSettings):
     """Envelope schemes (default estimator) at the rigid envelope's first failing amplitude.
 
     Returns ``(case, runs)`` with ``runs = [(label, Result)]``, or ``(None, [])`` when no rigid
@@ -545,7 +545,7 @@ def _near_threshold(scans: list[dict[str, Any]], cfgs: list[Config], st: Setting
     return None, []
 
 
-def _band_gain_job(job: tuple[Config, str, str, tuple[float, ...], float, Settings]) -> dict[str, Any]:
+def _band_gain_job(job: tuple[Config, str, str, tuple[float, ...], float, AblationSettings]) -> dict[str, Any]:
     cfg, condition, direction, vec, amp, st = job
     res = _run(_scenario(cfg, condition, st.horizon, tuple(amp * x for x in vec), st, log_dt=0.001))
     return {"config": cfg.label, "condition": condition, "direction": direction, "amplitude": amp,
@@ -553,7 +553,7 @@ def _band_gain_job(job: tuple[Config, str, str, tuple[float, ...], float, Settin
             "band_gain_ratio": band_gain_ratio(res, st.pulse_start)}
 
 
-def band_gain(scans: list[dict[str, Any]], cfgs: list[Config], st: Settings, progress: bool = False) -> list[dict]:
+def band_gain(scans: list[dict[str, Any]], cfgs: list[Config], st: AblationSettings, progress: bool = False) -> list[dict]:
     """G/Omega inside the risk monitor's band, where the monitor acts most.
 
     For every (direction, condition), the proactive envelope with the ``omega`` and the default
@@ -573,7 +573,7 @@ def band_gain(scans: list[dict[str, Any]], cfgs: list[Config], st: Settings, pro
     return _pool_map(_band_gain_job, jobs, progress, "band gain") if jobs else []
 
 
-def _near_figure(case: dict[str, Any], runs: list[tuple[str, Result]], st: Settings):
+def _near_figure(case: dict[str, Any], runs: list[tuple[str, Result]], st: AblationSettings):
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(10, 3.8))
@@ -606,7 +606,7 @@ def _rows(scans: list[dict[str, Any]], condition: str, direction: str) -> dict[s
     return {r["config"]: r for r in scans if r["condition"] == condition and r["direction"] == direction}
 
 
-def verdicts(scans: list[dict[str, Any]], st: Settings) -> tuple[dict[str, list[str]], dict[str, Any]]:
+def verdicts(scans: list[dict[str, Any]], st: AblationSettings) -> tuple[dict[str, list[str]], dict[str, Any]]:
     """Plain statements per direction comparing the envelope schemes, and a tally per direction.
 
     Tally per direction, each ``[better, equal, worse]`` over the (condition, estimator) cases:
@@ -647,7 +647,7 @@ def verdicts(scans: list[dict[str, Any]], st: Settings) -> tuple[dict[str, list[
     return lines, tally
 
 
-def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Settings | None = None,
+def run(out: Path, *, quick: bool = False, progress: bool = False, settings: AblationSettings | None = None,
         pulse: str | Sequence[float] | None = None, pulse_start: float | None = None) -> Path:
     """Run the ablation study and write ``report.md``, ``results.json`` and figures to ``out``.
 
@@ -656,10 +656,10 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     out : pathlib.Path
         Output folder (created).
     quick : bool, optional
-        CI-sized run (:meth:`Settings.quick`).
+        CI-sized run (:meth:`AblationSettings.quick`).
     progress : bool, optional
         Show progress bars.
-    settings : Settings, optional
+    settings : AblationSettings, optional
         Override the study's settings (tests, experiments); ``quick``, ``pulse`` and
         ``pulse_start`` are then ignored.
     pulse : str or sequence of float, optional

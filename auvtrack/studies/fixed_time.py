@@ -71,7 +71,7 @@ def magnitude_grid(lo: float = 1e-2, hi: float = 10 ** 1.5, per_decade: int = 2)
 
 
 @dataclass(frozen=True)
-class Settings:
+class FixedTimeSettings:
     """Everything that defines a run of the study (``quick`` shrinks it)."""
 
     magnitudes: tuple[float, ...] = tuple(magnitude_grid().tolist())
@@ -82,13 +82,13 @@ class Settings:
     starts: tuple[str, ...] = STARTS
 
     @classmethod
-    def quick(cls) -> "Settings":
+    def quick(cls) -> "FixedTimeSettings":
         """CI-sized: 4 magnitudes over 3 decades, 2 directions, 20 s."""
         return cls(magnitudes=(0.01, 0.1, 1.0, 10.0), directions=("+x", "+x+y+z"), duration=20.0,
                    starts=("matched",), controllers=("fxtntsmc", "ftsmc"))
 
 
-def initial_scenario(variant: str, e0: Sequence[float], st: Settings, start: str = "matched") -> Scenario:
+def initial_scenario(variant: str, e0: Sequence[float], st: FixedTimeSettings, start: str = "matched") -> Scenario:
     """Section 4 with controller ``variant`` (:data:`VARIANTS`) and the virtual point started at eta_d(0) + e0 (m).
 
     ``start = "matched"``: heading and pitch along the reference tangent and body velocities
@@ -117,7 +117,7 @@ def initial_scenario(variant: str, e0: Sequence[float], st: Settings, start: str
                                           f"initial.nu=[{', '.join(repr(x) for x in nu)}]"])
 
 
-def _run_one(job: tuple[str, str, str, float, Settings]) -> dict[str, Any]:
+def _run_one(job: tuple[str, str, str, float, FixedTimeSettings]) -> dict[str, Any]:
     start, kind, dname, mag, st = job
     e0 = mag * np.asarray(DIRECTIONS[dname])
     prep = prepare(initial_scenario(kind, e0, st, start))
@@ -179,7 +179,7 @@ def _monotone(per_mag: dict[float, float | None], failed: dict[float, int], n_di
     return {"nondecreasing": not drops, "decreases": drops}
 
 
-def _analysis(rows: list[dict[str, Any]], st: Settings) -> dict[str, Any]:
+def _analysis(rows: list[dict[str, Any]], st: FixedTimeSettings) -> dict[str, Any]:
     out: dict[str, Any] = {}
     mags = sorted(st.magnitudes)
     top_lo = mags[-1] / 10.0
@@ -293,7 +293,7 @@ def verdict(data: dict[str, Any], start: str = "matched", thresholds: tuple[str,
     return {"verdict": word, "start": start, "thresholds": list(thresholds), "shown": shown, "not_shown": not_shown}
 
 
-def _figure(rows: list[dict[str, Any]], bounds: dict[str, Any], st: Settings):
+def _figure(rows: list[dict[str, Any]], bounds: dict[str, Any], st: FixedTimeSettings):
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(11, 4.5))
@@ -343,7 +343,7 @@ def _figure(rows: list[dict[str, Any]], bounds: dict[str, Any], st: Settings):
     return fig
 
 
-def _trace_figure(rows: list[dict[str, Any]], st: Settings):
+def _trace_figure(rows: list[dict[str, Any]], st: FixedTimeSettings):
     from matplotlib.figure import Figure
 
     d = st.directions[0]
@@ -370,7 +370,7 @@ def _trace_figure(rows: list[dict[str, Any]], st: Settings):
     return fig
 
 
-def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Settings | None = None) -> Path:
+def run(out: Path, *, quick: bool = False, progress: bool = False, settings: FixedTimeSettings | None = None) -> Path:
     """Run the fixed-time study and write ``report.md``, ``results.json`` and figures to ``out``.
 
     Parameters
@@ -378,10 +378,10 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     out : pathlib.Path
         Output folder (created).
     quick : bool, optional
-        CI-sized run (:meth:`Settings.quick`).
+        CI-sized run (:meth:`FixedTimeSettings.quick`).
     progress : bool, optional
         Show a progress bar.
-    settings : Settings, optional
+    settings : FixedTimeSettings, optional
         Override the settings (tests, experiments); ``quick`` is then ignored.
 
     Returns
@@ -391,7 +391,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Set
     """
     from tqdm.auto import tqdm
 
-    st = settings or (Settings.quick() if quick else Settings())
+    st = settings or (FixedTimeSettings.quick() if quick else FixedTimeSettings())
     out = Path(out)
     jobs = [(s0, k, d, float(m), st) for s0 in st.starts for k in st.controllers for d in st.directions
             for m in st.magnitudes]

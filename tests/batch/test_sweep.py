@@ -67,7 +67,7 @@ def client():
 
     from auvtrack.simulation.compiling import warmup
 
-    warmup()  # compile once here (or load the cache) so that the workers only load it
+    warmup(("ftsmc", "fxtntsmc"), ("5dof",))  # the study's kernels, compiled here once: the workers only load them
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
                       memory_limit="800MiB") as cluster, Client(cluster) as c:
         yield c

@@ -78,12 +78,12 @@ def _jsonish(obj):
 
 def test_stored_results_come_from_the_current_study_definitions():
     ab = findings.load("ablation")
-    assert ab["settings"] == _jsonish({**asdict(ablation.Settings()), "horizon": ablation.Settings().horizon})
+    assert ab["settings"] == _jsonish({**asdict(ablation.AblationSettings()), "horizon": ablation.AblationSettings().horizon})
     s40 = findings.load("ablation-surge40")
     want = ablation.settings_for(pulse="1,0,0,0.25,0.25", pulse_start=40.0)
     assert s40["settings"] == _jsonish({**asdict(want), "horizon": want.horizon})
     ft = findings.load("fixed-time")
-    assert ft["settings"] == _jsonish(asdict(fixed_time.Settings()))
+    assert ft["settings"] == _jsonish(asdict(fixed_time.FixedTimeSettings()))
     assert ft["estimator"] == findings.DEFAULT_EST
     rb = findings.load("robustness")
     # workers only say how many threads ran the batch (every back end gives bit-identical results)

@@ -163,7 +163,7 @@ def test_configuration_grid():
 
 def test_pulse_is_added_to_section4():
     cfg = configurations()[-1]
-    st_ = ablation.Settings()
+    st_ = ablation.AblationSettings()
     sc = ablation._scenario(cfg, "sampled", 30.0, (0, 5.0, 0, 0, 0), st_)
     kinds = [d["kind"] for d in sc.disturbance]
     assert kinds == ["paper", "pulse"]
@@ -177,7 +177,7 @@ def test_pulse_options_set_one_direction_and_the_onset():
     assert st_.directions == (("pulse [1, 0, 0, 0.25, 0.25]", (1.0, 0.0, 0.0, 0.25, 0.25)),)
     assert st_.pulse_start == 40.0 and st_.horizon == 60.0
     q = ablation.settings_for(quick=True, pulse="0,1,0,0,0")
-    assert q.configs == ablation.Settings.quick().configs and len(q.directions) == 1
+    assert q.configs == ablation.AblationSettings.quick().configs and len(q.directions) == 1
     assert {c.split("/")[1] for c in q.configs} == {"none", "rigid", "proactive"}
     assert {c.split("/")[2] for c in q.configs} == {ablation.DEFAULT_ESTIMATOR}
 
@@ -213,7 +213,7 @@ def test_quick_ablation_end_to_end(quick_run):
     assert "Survival per configuration" in text and "figures/survival.png" in text and "### heave pulse" in text
     assert (out / "figures" / "survival.png").exists()
     data = json.loads((out / "results.json").read_text())
-    st_ = ablation.Settings.quick()
+    st_ = ablation.AblationSettings.quick()
     assert len(data["scans"]) == len(st_.configs) * len(st_.directions) * len(st_.conditions)
     assert len(data["nominal"]) == len(st_.configs)
     grid = amplitude_grid(st_.a_min, st_.a_max, st_.per_decade)

@@ -10,10 +10,10 @@ import pytest
 from auvtrack.vehicle.kinematics import attitude, j3, virtual_point
 from auvtrack.reference import build_reference
 from auvtrack.studies import fixed_time
-from auvtrack.studies.fixed_time import DIRECTIONS, Settings, initial_scenario, magnitude_grid
+from auvtrack.studies.fixed_time import DIRECTIONS, FixedTimeSettings, initial_scenario, magnitude_grid
 
 
-@pytest.mark.parametrize("st", [Settings(), Settings.quick()], ids=["default", "quick"])
+@pytest.mark.parametrize("st", [FixedTimeSettings(), FixedTimeSettings.quick()], ids=["default", "quick"])
 def test_initial_error_grid_spans_three_decades_and_several_directions(st):
     mags = np.array(st.magnitudes)
     assert np.all(mags > 0) and np.all(np.diff(np.sort(mags)) > 0)
@@ -25,7 +25,7 @@ def test_initial_error_grid_spans_three_decades_and_several_directions(st):
 
 
 def test_default_grid_has_at_least_three_directions_and_both_starts():
-    st = Settings()
+    st = FixedTimeSettings()
     assert len(st.directions) >= 3 and set(st.starts) == {"matched", "rest"}
 
 
@@ -40,7 +40,7 @@ def test_magnitude_grid_is_log_spaced():
 @pytest.mark.parametrize("start", ["matched", "rest"])
 @pytest.mark.parametrize("e0", [(0.01, 0, 0), (-3.0, 2.0, 1.0)])
 def test_start_puts_the_virtual_point_at_the_requested_error(start, e0):
-    st = Settings(duration=10.0)
+    st = FixedTimeSettings(duration=10.0)
     sc = initial_scenario("fxtntsmc", e0, st, start)
     eta, nu = np.array(sc.initial.eta), np.array(sc.initial.nu)
     ell = sc.vehicle.l if sc.vehicle.l is not None else 1.0
@@ -67,7 +67,7 @@ def quick_run(tmp_path_factory):
 
 def test_quick_fixed_time_end_to_end(quick_run):
     out, report = quick_run
-    st = Settings.quick()
+    st = FixedTimeSettings.quick()
     assert report.exists()
     text = report.read_text()
     assert "Theorem 1's bounds" in text and "widen_start" in text and "Start treatment" in text
@@ -110,7 +110,7 @@ def test_quick_fixed_time_end_to_end(quick_run):
 def test_zero_weight_variant_starts_the_network_at_zero():
     from auvtrack.simulation.pipeline import prepare
 
-    st = Settings(duration=1.0)
+    st = FixedTimeSettings(duration=1.0)
     p0 = prepare(initial_scenario("fxtntsmc-w0", (0.1, 0.0, 0.0), st))
     p1 = prepare(initial_scenario("fxtntsmc", (0.1, 0.0, 0.0), st))
     w0, w1 = np.array(p0.resolved["controller"]["rbf_weights0"]), np.array(p1.resolved["controller"]["rbf_weights0"])

@@ -8,7 +8,7 @@ from auvtrack.studies import ablation
 
 def test_ablation_summary_of_an_envelope_free_run_is_silent():
     cfg = next(c for c in ablation.configurations() if c.label == ablation.config_label("none", "omega"))
-    st = ablation.Settings.quick()
+    st = ablation.AblationSettings.quick()
     res = ablation._run(ablation._scenario(cfg, "continuous", 22.0, None, st))
     assert res.ok and not (res["rho_x"] == res["rho_x"]).any()  # envelope "none": rho is NaN throughout
     with warnings.catch_warnings():
