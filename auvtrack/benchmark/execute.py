@@ -26,6 +26,7 @@ from typing import Any, Callable, Sequence
 
 from ..batch.chunk_files import chunk_path
 from ..batch.executor import ChunkJob, check_workers, execute_chunks
+from ..control.plugin import PluginFailure
 
 __all__ = ["RunSpec", "plan_size", "check_plan", "check_plugin_setups", "plan_runs", "run_planned", "run_chunk", "execute", "ExecOutcome",
            "CompareJob", "CompareError", "chunk_path", "MANIFEST", "RUNS_FILE", "FIXED_COLUMNS", "DEFAULT_MAX_RUNS",
@@ -36,7 +37,7 @@ RUNS_FILE = "runs.parquet"
 FIXED_COLUMNS = ("run", "controller", "task", "tier", "seed_index", "seed", "status", "cause", "detail",
                  "fail_time", "t_stop", "steps", "draws")
 DEFAULT_MAX_RUNS = 100_000
-"""Default bound on the runs of one comparison (``--max-runs``): about 8 x the default suite's."""
+"""Default bound on the runs of one comparison (``--max-runs``): several times the default suite's."""
 MAX_RUNS = 1_000_000
 """Hard ceiling of ``--max-runs`` (the runs table and its statistics are held in memory)."""
 
@@ -192,6 +193,8 @@ def _prepare(spec: RunSpec):
             warnings.simplefilter("ignore")
             return prepare(load_scenario(spec.raw, spec.overrides))
     except refusals as exc:
+        if isinstance(exc, PluginFailure):
+            return exc.cause
         text = " ".join(str(exc).split()) or type(exc).__name__
         return text if isinstance(exc, ValueError) else f"{type(exc).__name__}: {text}"
 
@@ -228,6 +231,9 @@ def check_plugin_setups(suite, entries: Sequence) -> None:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 prepare(load_scenario(spec.raw, spec.overrides))
+        except PluginFailure as exc:
+            raise CompareError(f"--plugin: {e.table.get('module')}: its set-up fails on task {spec.task}, tier "
+                               f"{spec.tier}: {exc.cause}") from None
         except ValueError:
             pass  # a refusal of this run (ScenarioError is one): recorded as a set-up failure
         except Exception as exc:  # noqa: BLE001 - the plug-in's own code

@@ -182,6 +182,8 @@ def rpm_for(T, u, a, b):
     """
     bu = b * u
     disc = bu * bu + 4.0 * a * T
+    if -1e-12 * bu * bu <= disc < 0.0:
+        disc = 0.0  # the forward branch's vertex n = -b u / 2a, within rounding: both branches reach it
     if disc >= 0.0 and math.sqrt(disc) >= bu:
         return (-bu + math.sqrt(disc)) / (2.0 * a)
     return -math.sqrt(max(-T, 0.0) / a)

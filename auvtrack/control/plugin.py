@@ -36,7 +36,25 @@ from .tracking import error_state, error_state_forces, input_for_accel, input_fo
 
 NAME = "plugin"
 
-__all__ = ["Params", "setup", "load", "spec_of", "CompiledController", "ControllerParamsBase", "ControllerParams",
+
+class PluginFailure(ValueError):
+    """A plug-in's own code broke (raised anything but the contract's ``ValueError`` refusal).
+
+    Parameters
+    ----------
+    module : str
+        The plug-in's file or module.
+    cause : str
+        ``Type: first line`` of the exception it raised.
+    """
+
+    def __init__(self, module: str, cause: str) -> None:
+        super().__init__(f"controller.module: {module}: setup fails: {cause}")
+        self.module = module
+        self.cause = cause
+
+
+__all__ = ["PluginFailure", "Params", "setup", "load", "spec_of", "CompiledController", "ControllerParamsBase", "ControllerParams",
            "SetupContext", "njit", "njit_noalloc", "packed_layout", "tunable", "error_state", "error_state_forces",
            "input_for_accel", "input_for_accel_forces", "sig", "sign", "WORK_SIZE", "CONTROLLER_STATUS"]
 
@@ -212,7 +230,7 @@ def setup(params: Params, ctx: SetupContext) -> CompiledController:
     except ValueError:
         raise  # the plug-in's own one-line refusal (a gain condition)
     except Exception as exc:
-        raise ValueError(f"controller.module: {params.module}: setup fails: {first_line(exc)}") from None
+        raise PluginFailure(params.module, first_line(exc)) from None
     cc = _check_compiled(made, spec, params.module)
     _probe(mod, params.module, cc, ctx)
     resolved = {**cc.resolved, "plugin": {"module": params.module, "params": params.params}}

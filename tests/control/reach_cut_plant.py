@@ -73,6 +73,13 @@ def allocate(tau3, eta, nu, x, pp, prev, h, cmd):
 
 
 @njit_noalloc
+def effort(x, cmd, pp):
+    """|applied tau_j| / limit_j at the state's clock (0 when unlimited)."""
+    m = limits(x, pp)
+    return abs(cmd[0]) / m[0], abs(cmd[1]) / m[1], abs(cmd[2]) / m[2]
+
+
+@njit_noalloc
 def rhs(t, x, att, cmd, env, pp, scr, fresh, dx):
     """dx = (eta_dot, nu_dot, 1): eq. (1) with the applied tau, no environment."""
     eta, nu = pose(x)
