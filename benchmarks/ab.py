@@ -28,10 +28,11 @@ from pathlib import Path
 WORKER = r"""
 import json, sys, time
 from auvtrack.scenario import load_scenario, paper_scenario_path
-from auvtrack.simulation.pipeline import prepare
 try:
+    from auvtrack.simulation.pipeline import prepare
     from auvtrack.batch.runner import run_batch, run_metrics
 except ImportError:  # a tree of the 0.1 layout
+    from auvtrack.simulation.api import prepare
     from auvtrack.runner.batch import run_batch, run_metrics
 import auvtrack
 overrides, batch = json.loads(sys.argv[1]), int(sys.argv[2])
