@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass
 from .errors import ScenarioError
 from .schema import Scenario, SimSection
 
-__all__ = ["RunPlan", "plan_run", "LOG_COPIES", "NOISE_BYTES_PER_ROW", "CURRENT_BYTES_PER_ROW",
+__all__ = ["RunPlan", "plan_run", "check_state_memory", "STATE_COPIES", "LOG_COPIES", "NOISE_BYTES_PER_ROW", "CURRENT_BYTES_PER_ROW",
            "CSV_BLOCK_ROWS", "CSV_BYTES_PER_VALUE"]
 
 FLOAT = 8  # bytes
@@ -26,6 +26,7 @@ LOG_COPIES = 3  # the engine's log, the per-channel copies, the Result's private
 NOISE_COLS = 10
 NOISE_BYTES_PER_ROW = 2 * NOISE_COLS * FLOAT  # the normal draws and the scaled table
 CURRENT_BYTES_PER_ROW = 128  # sampling transients plus the stacked table (measured peak 104, docs)
+STATE_COPIES = 8  # the bundle's start, the running state, the state after a step, the stage state, 4 RK4 slopes
 CSV_BLOCK_ROWS = 2000  # Result.save writes the CSV in blocks of this many rows
 CSV_BYTES_PER_VALUE = 160  # Python float + its repr string while a block is formatted
 _DEFAULT_DT = SimSection.model_fields["dt"].default
@@ -161,6 +162,44 @@ def plan_run(scenario: Scenario, n_channels: int) -> RunPlan:
         raise _over(path, f"the run's arrays need an estimated {plan.memory_bytes / 2 ** 20:.0f} MiB "
                     f"({parts[path] / 2 ** 20:.0f} MiB from this field)", "max_memory_mb", lim.max_memory_mb)
     return plan
+
+
+def check_state_memory(scenario: Scenario, plan: RunPlan, state_floats: dict[str, int]) -> int:
+    """Check the run's arrays with the plant's and the controller's states against ``max_memory_mb``.
+
+    The state sizes are known only once the plant and the controller are set up (a plug-in
+    chooses its own), so :func:`plan_run` cannot count them; :func:`~auvtrack.simulation.pipeline.prepare`
+    calls this right after the set-up, before the engine makes its copies of the states.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The validated scenario (its ``[limits]``).
+    plan : RunPlan
+        Its plan (:func:`plan_run`).
+    state_floats : dict of str to int
+        Floats each piece holds for the run (state and packed parameters), keyed by the scenario
+        section that chooses them (``"plant"``, ``"controller"``).
+
+    Returns
+    -------
+    int
+        Estimated bytes of the states with the engine's copies (:data:`STATE_COPIES` each, 8 bytes a float).
+
+    Raises
+    ------
+    ScenarioError
+        One line naming the section with the larger state, the estimate and ``limits.max_memory_mb``.
+    """
+    lim = scenario.limits
+    parts = {k: STATE_COPIES * FLOAT * int(n) for k, n in state_floats.items()}
+    state_bytes = sum(parts.values())
+    if plan.memory_bytes + state_bytes > lim.max_memory_mb * 2 ** 20:
+        path = max(parts, key=parts.get)
+        raise _over(path, f"the run's arrays need an estimated {(plan.memory_bytes + state_bytes) / 2 ** 20:.0f} MiB "
+                    f"({parts[path] / 2 ** 20:.0f} MiB for the {path}'s state and parameters, "
+                    f"{state_floats[path]} floats kept in {STATE_COPIES} copies)", "max_memory_mb", lim.max_memory_mb)
+    return state_bytes
 
 
 def _current_samples(spec: dict, duration: float) -> int:

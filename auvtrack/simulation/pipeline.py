@@ -31,7 +31,7 @@ from ..reference import build_reference
 from ..reference.start import start_note
 from ..scenario import Scenario, load_scenario
 from ..scenario.designed import design_record
-from ..scenario.plan import plan_run
+from ..scenario.plan import check_state_memory, plan_run
 from ..interrupt import Outcome, run_in_thread
 from ..user_modules import first_line, load_module
 from ..engine import loop as engine
@@ -165,6 +165,8 @@ def prepare(scenario: Scenario) -> Prepared:
     cc = cspec.setup(sc.controller, ctx)
     channels = channel_names(cc.aux_names, cpl.log_names)
     plan = plan_run(sc, len(channels))  # every size checked against [limits] before any allocation
+    check_state_memory(sc, plan, {"plant": np.size(cpl.x0) + np.size(cpl.pp),
+                                  "controller": np.size(cc.xc0) + np.size(cc.cp)})
     tables = pack_disturbances([build_disturbance(dict(d)) for d in sc.disturbance], sc.sim.duration, sc.seed)
     dt = sc.sim.dt
     n_steps, log_every, ctrl_every = plan.n_steps, plan.log_every, plan.control_every
