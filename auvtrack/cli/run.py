@@ -8,6 +8,7 @@ import click
 
 from .common import (EXIT_CODES_HELP, EXIT_INTERRUPTED, EXIT_SIM_FAILED, LONG_RUN_STEPS, BadInput, cli, load_arg, mib,
                      one_line, prepare_arg, set_option)
+from .signals import stop_requests
 
 
 @cli.command(epilog=EXIT_CODES_HELP)
@@ -52,12 +53,19 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         res = run_prepared(prep)
     except SimulationInterrupted as exc:  # stopped within about a second; write what was computed
         res = exc.result
-    try:
-        folder = res.save(target, mat=mat or sc.output.mat, overwrite=out is not None)
+    try:  # Ctrl-C while the folder is written: keep the rows written so far, publish, exit 130
+        with stop_requests() as requested:
+            folder = res.save(target, mat=mat or sc.output.mat, overwrite=out is not None, stop=requested)
     except OSError as exc:  # FolderError (the folder changed since the check), a full disk...
         click.echo(f"auvtrack: error: the run folder {target} could not be written: {one_line(exc)}", err=True)
         raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
+    if requested():
+        kept = json.loads((folder / "run.json").read_text(encoding="utf-8"))["files"]["trajectory.csv"]
+        rows = kept.get("rows", len(res))
+        click.echo(f"auvtrack: interrupted while writing the run folder; trajectory.csv holds {rows} of {len(res)} "
+                   f"rows, run.json the whole run's status and metrics: kept in {folder}", err=True)
+        raise click.exceptions.Exit(EXIT_INTERRUPTED)
     if res.status == "interrupted":
         click.echo(f"auvtrack: interrupted at t = {res.failure['time']:.6g} s after {res.meta['steps']} of "
                    f"{prep.n_steps} steps; partial result kept in {folder}", err=True)

@@ -12,9 +12,9 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
-from typing import Iterator
+from typing import Callable, Iterator
 
-__all__ = ["stop_once"]
+__all__ = ["stop_once", "stop_requests"]
 
 
 @contextlib.contextmanager
@@ -47,3 +47,29 @@ def stop_once() -> Iterator[None]:
     finally:
         for sig, handler in previous.items():  # once stopping, the process is ending: stay deaf until it exits
             signal.signal(sig, signal.SIG_IGN if stopping else handler)
+
+
+@contextlib.contextmanager
+def stop_requests() -> Iterator[Callable[[], bool]]:
+    """Record SIGINT and SIGTERM instead of raising, for work that must end in a consistent state.
+
+    Writing a run folder is such work: an exception in the middle would throw away a result that
+    is already computed, so the writer asks between blocks whether to stop and keeps what it wrote.
+
+    Yields
+    ------
+    callable
+        ``requested()``: True once a signal arrived.  Outside the main thread it is always False.
+        The previous handlers are restored on exit.
+    """
+    got: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+    previous = {sig: signal.signal(sig, lambda signum, frame: got.append(signum))
+                for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield lambda: bool(got)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)

@@ -18,7 +18,7 @@ import re
 import shutil
 import stat
 from pathlib import Path
-from typing import Any, BinaryIO, Iterator, Mapping
+from typing import Any, BinaryIO, Callable, Iterator, Mapping
 
 import numpy as np
 
@@ -450,14 +450,20 @@ class Result:
             doc["files"] = dict(files)
         return json.dumps(doc, indent=2, allow_nan=False, ensure_ascii=False) + "\n"
 
-    def _write_csv(self, fh) -> None:
-        """Stream the CSV in blocks of :data:`CSV_BLOCK_ROWS` rows (memory flat in the run length)."""
+    def _write_csv(self, fh, stop: Callable[[], bool] | None = None) -> int:
+        """Stream the CSV in blocks of :data:`CSV_BLOCK_ROWS` rows (memory flat in the run length).
+
+        Before each block ``stop()`` is asked whether to end there; returns the rows written.
+        """
         fh.write((",".join(self._ch) + "\n").encode("utf-8"))
         arrays = list(self._ch.values())
         for start in range(0, len(self), CSV_BLOCK_ROWS):
+            if stop is not None and stop():
+                return start
             # repr of a Python float is the shortest string that round-trips bit-exactly
             cols = [list(map(repr, v[start:start + CSV_BLOCK_ROWS].tolist())) for v in arrays]
             fh.write("".join(",".join(r) + "\n" for r in zip(*cols)).encode("utf-8"))
+        return len(self)
 
     def _csv_text(self) -> str:
         import io
@@ -485,7 +491,8 @@ class Result:
                   "(same auvtrack version and machine); see docs/scenarios.md.")
         return dumps(doc, header=header)
 
-    def save(self, out_dir: str | os.PathLike, mat: bool = False, *, overwrite: bool = True) -> Path:
+    def save(self, out_dir: str | os.PathLike, mat: bool = False, *, overwrite: bool = True,
+             stop: Callable[[], bool] | None = None) -> Path:
         """Write the run folder: ``trajectory.csv``, ``run.json``, ``scenario.toml``, optionally ``trajectory.mat``.
 
         Parameters
@@ -499,6 +506,11 @@ class Result:
             False: never replace a folder; when ``out_dir`` is taken (by the time the run is
             published), use the first free ``<out_dir>-2``, ``-3``, ... instead (the default run
             folders of ``auvtrack run``).
+        stop : callable, optional
+            Asked between blocks of :data:`CSV_BLOCK_ROWS` rows (``auvtrack run`` passes "was
+            Ctrl-C pressed"): when it returns True the CSV ends at that block, ``trajectory.mat``
+            is skipped, and the folder is still completed and published, ``run.json`` recording
+            ``"rows"`` (written) and ``"rows_in_result"`` under ``files["trajectory.csv"]``.
 
         Returns
         -------
@@ -530,15 +542,17 @@ class Result:
             files: dict[str, Any] = {}
             with open_exclusive(tmp / CSV_NAME) as fh:
                 w = _HashingWriter(fh)
-                self._write_csv(w)
+                rows = self._write_csv(w, stop)
                 files[CSV_NAME] = w.record()
+            if rows < len(self):
+                files[CSV_NAME].update(rows=rows, rows_in_result=len(self))
             toml = self.scenario_toml()
             if toml is not None:
                 data = toml.encode("utf-8")
                 with open_exclusive(tmp / TOML_NAME) as fh:
                     fh.write(data)
                 files[TOML_NAME] = {"sha256": hashlib.sha256(data).hexdigest(), "bytes": len(data)}
-            if mat:
+            if mat and rows == len(self):
                 self._save_mat(tmp / MAT_NAME)
             with open_exclusive(tmp / JSON_NAME) as fh:
                 fh.write(self._json_document(files).encode("utf-8"))
