@@ -32,7 +32,7 @@ MANIFEST = "study.json"
 RESULTS = "results.parquet"
 QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 
-__all__ = ["run_sweep", "SweepOutcome", "SweepJob", "chunk_path", "read_results", "summarize", "MANIFEST", "RESULTS"]
+__all__ = ["run_sweep", "SweepOutcome", "SweepJob", "chunk_path", "read_results", "summarize", "counts_text", "MANIFEST", "RESULTS"]
 
 
 @dataclass(frozen=True)
@@ -350,7 +350,7 @@ def summary_markdown(s: dict) -> str:
     """Render a summary (from :func:`summarize`) as Markdown: one quantile table per group."""
     lines = [f"# Sweep {s['study']}", "", f"Study file: `{s['source']}`; varied: "
              f"{', '.join(f'`{k}`' for k in s['varied']) or 'nothing (replicates only)'}.", "",
-             f"Samples: {s['samples']} — " + _counts_text(s), ""]
+             f"Samples: {s['samples']} — " + counts_text(s), ""]
     if s["causes"]:
         lines += ["Failure causes: " + ", ".join(f"{k} ({v})" for k, v in sorted(s["causes"].items())) + ".", ""]
     if "seconds" in s and s["seconds"]:
@@ -362,14 +362,15 @@ def summary_markdown(s: dict) -> str:
               "groups are never pooled.", ""]
     for g in groups:
         name = ", ".join(f"{k} = {v}" for k, v in g["key"].items())
-        lines += [f"## {name}", "", f"Samples: {g['samples']} — " + _counts_text(g), ""]
+        lines += [f"## {name}", "", f"Samples: {g['samples']} — " + counts_text(g), ""]
         if g["causes"]:
             lines += ["Failure causes: " + ", ".join(f"{k} ({v})" for k, v in sorted(g["causes"].items())) + ".", ""]
         lines += _quantile_table(g, s["quantile_levels"]) + [""]
     return "\n".join(lines).rstrip("\n") + "\n"
 
 
-def _counts_text(s: dict) -> str:
+def counts_text(s: dict) -> str:
+    """One plain sentence of a summary's (or a group's) status counts and failure rate."""
     return (", ".join(f"{k}: {v}" for k, v in sorted(s["counts"].items())) + f"; failure rate {s['failure_rate']:.2%}"
             + (f", invalid {s['invalid_rate']:.2%}" if s["invalid_rate"] else "") + ".")
 

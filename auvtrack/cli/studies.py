@@ -1,11 +1,13 @@
 """``auvtrack reproduce | study``: the paper's Section 4 and the registered studies."""
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import click
 
 from .common import BadInput, cli
+from .digest import reproduce_lines
 
 
 @cli.command()
@@ -20,8 +22,9 @@ def reproduce(out: str, quick: bool) -> None:
     """
     from ..studies.reproduce import reproduce as _reproduce
 
-    summary = _reproduce(Path(out), quick=quick, progress=True)
-    click.echo(summary)
+    _reproduce(Path(out), quick=quick, progress=True)
+    metrics = json.loads((Path(out) / "metrics.json").read_text(encoding="utf-8"))
+    click.echo("\n".join(reproduce_lines(metrics)))
     click.echo(f"written: {Path(out) / 'summary.md'}, {Path(out) / 'report.html'}")
 
 

@@ -9,6 +9,7 @@ import click
 from ..batch.executor import MAX_WORKERS
 from ..batch.scheduler import SCHEDULER_TIMEOUT_S
 from .common import EXIT_CODES_HELP, EXIT_INTERRUPTED, BadInput, cli
+from .digest import sweep_lines
 from .signals import stop_once
 
 DEFAULT_WORKER_MEMORY = "1GiB"  # auvtrack.batch.sweep.DEFAULT_WORKER_MEMORY (not imported: --help stays fast)
@@ -69,7 +70,7 @@ def sweep(study: str, out: str | None, workers: int | None, worker_memory: str, 
                        f"finish with: {again}", err=True)
             raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
     if res.complete:
-        click.echo((folder / "summary.md").read_text())
+        click.echo("\n".join(sweep_lines(res.summary)))
         click.echo(f"written: {folder / 'results.parquet'}, {folder / 'summary.json'}, {folder / 'summary.md'}")
     else:
         click.echo(f"stopped after {res.chunks_run} chunks; finish with: {again}")

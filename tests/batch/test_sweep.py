@@ -181,7 +181,9 @@ def test_cli_sweep_on_existing_scheduler(tmp_path, client, capsys):
     code = main(["sweep", str(study), "--out", str(tmp_path / "o"), "--scheduler", client.scheduler.address,
                  "--quiet"])
     assert code == 0, capsys.readouterr().err
-    assert "Samples: 20" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert out.startswith("sweep t: 20 samples, ") and "written: " in out, out
+    assert not [ln for ln in out.splitlines() if ln.lstrip().startswith(("#", "|"))], out  # no Markdown
     assert chunk_path(tmp_path / "o", 1).is_file() and len(read_results(tmp_path / "o")) == 20
 
 
