@@ -8,6 +8,7 @@ import click
 
 from .common import (EXIT_CODES_HELP, EXIT_INTERRUPTED, EXIT_SIM_FAILED, LONG_RUN_STEPS, BadInput, cli, load_arg, mib,
                      one_line, prepare_arg, set_option)
+from .digest import saturation_warning
 from .signals import stop_requests
 
 
@@ -60,6 +61,8 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         click.echo(f"auvtrack: error: the run folder {target} could not be written: {one_line(exc)}", err=True)
         raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
+    if res.ok and (line := saturation_warning(res.metrics, float(res.t[-1]))) is not None:
+        click.echo(f"warning: {line}", err=True)
     if requested():
         kept = json.loads((folder / "run.json").read_text(encoding="utf-8"))["files"]["trajectory.csv"]
         rows = kept.get("rows", len(res))

@@ -35,3 +35,21 @@ def test_sweep_lines_give_the_totals_and_one_line_per_group():
     assert lines[1:] == [f"  controller.kind = {k}: 4 samples, failed: 1, ok: 3; failure rate 25.00%."
                          for k in ("pid", "sta")]
     assert not _markdown(lines), lines
+
+
+def test_a_run_that_saturated_says_so_beside_status_ok(tmp_path, capsys):
+    """PID against a 200 N surge limit: ok, with the saturation time the metrics measured."""
+    import auvtrack
+    from auvtrack.cli import main
+    from auvtrack.cli.digest import saturation_warning
+
+    args = ["sim.duration=10", "controller.kind=pid", "actuator.tau_max=[200, 100, 100]"]
+    res = auvtrack.simulate("paper", args, warn=False)
+    assert res.ok and res.metrics["t_sat_tau_u"] > 0
+    line = saturation_warning(res.metrics, 10.0)
+    assert line.startswith(f"status ok, but the inputs saturated: surge {res.metrics['t_sat_tau_u']:.3g} s of 10 s;")
+    assert line.endswith(f"largest position error {res.metrics['max_abs_x']:.3g} m (x)")
+    assert main(["run", "paper", "--out", str(tmp_path / "r"), *(a for s in args for a in ("--set", s))]) == 0
+    assert f"warning: {line}" in capsys.readouterr().err
+    unsaturated = auvtrack.simulate("paper", ["sim.duration=1", "controller.kind=pid"], warn=False).metrics
+    assert saturation_warning(unsaturated, 1.0) is None
