@@ -37,6 +37,7 @@ from ..simulation.compiling import ensure_compiled
 from ..simulation.pipeline import (Prepared, call_kernel, failure_record, outputs_for, result_from,
                               status_of)
 from ..engine.loop import Outputs
+from ..interrupt import abandoned, run_in_thread
 from ..metrics import METRICS_SIZE, metrics_finalize, metrics_init
 from ..simulation.result import Result
 
@@ -385,33 +386,35 @@ def run_batch(preps: Sequence[Prepared], *, trajectories: bool = False, workers:
     stop = StopSignal()
     fn: Callable[[Prepared, StopSignal], Any] = _trajectory if trajectories else run_metrics
     if backend == "prange" and not trajectories:
-        return _guarded(lambda: _run_prange(preps, stop), stop)
+        return _guarded(lambda: _run_prange(preps, stop), stop, len(preps))
     if backend == "simd" and not trajectories:
-        return _guarded(lambda: _run_simd(preps, stop, workers), stop)
+        return _guarded(lambda: _run_simd(preps, stop, workers), stop, len(preps))
     if backend == "serial" or workers == 1 or len(preps) == 1:
         workers = 1
     pool = ThreadPoolExecutor(max_workers=min(workers, len(preps)))
     futures = [pool.submit(fn, p, stop) for p in preps]
     try:
-        results = [f.result() for f in futures]
-    except KeyboardInterrupt:
-        stop.set()
-        results = [f.result() for f in futures]
-        pool.shutdown()
-        raise BatchInterrupted(results) from None
-    pool.shutdown()
-    return results
+        return _bounded(lambda: [f.result() for f in futures], stop,
+                        lambda: [f.result() if f.done() and f.exception() is None else None for f in futures])
+    finally:
+        pool.shutdown(wait=not abandoned(), cancel_futures=True)
 
 
-def _guarded(fn, stop: StopSignal):
-    """Run ``fn()`` in a worker thread; on Ctrl-C set ``stop``, wait, and raise :class:`BatchInterrupted`."""
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        fut = pool.submit(fn)
-        try:
-            return fut.result()
-        except KeyboardInterrupt:
-            stop.set()
-            raise BatchInterrupted(fut.result()) from None
+def _guarded(fn, stop: StopSignal, n: int):
+    """Run ``fn()`` (``n`` runs) in a worker thread; on Ctrl-C set ``stop`` and raise :class:`BatchInterrupted`."""
+    return _bounded(fn, stop, lambda: [None] * n)
+
+
+def _bounded(work: Callable[[], list], stop: StopSignal, partial: Callable[[], list]) -> list:
+    """Wait for ``work()`` in a daemon thread (:func:`auvtrack.interrupt.run_in_thread`), so that Ctrl-C
+    always reaches this thread.  On Ctrl-C ``stop`` is set and the runs get
+    :data:`auvtrack.interrupt.GRACE_S` to stop; a law or plant that never returns (an endless loop)
+    is abandoned, its outcome None in :class:`BatchInterrupted` ``results`` (``partial()``), and the
+    process must end with ``os._exit`` (the command line does)."""
+    outcome = run_in_thread(work, stop.set)
+    if outcome.interrupted:
+        raise BatchInterrupted(partial() if outcome.abandoned else outcome.value)
+    return outcome.value
 
 
 def iter_batch(items: Iterable[Any], prepare_fn: Callable[[Any], Prepared], *, block: int = 64,
