@@ -4,5 +4,6 @@
 (:func:`auvtrack.control.registry.tunable`) and the set-up conditions a candidate must meet.
 """
 from .space import Dimension, constraint_violations, distributions, search_space
+from .study import TuneResult, tune
 
-__all__ = ["Dimension", "constraint_violations", "distributions", "search_space"]
+__all__ = ["Dimension", "TuneResult", "constraint_violations", "distributions", "search_space", "tune"]

@@ -115,8 +115,11 @@ def constraint_violations(scenario) -> list[str]:
     from ..control import spec_for as controller_spec_for
     from ..simulation.pipeline import prepare
 
-    spec = controller_spec_for(scenario.controller)
-    problems = list(spec.warnings(scenario.controller)) if spec.warnings is not None else []
+    section = scenario.controller
+    spec = controller_spec_for(section)
+    problems = []
+    if spec.warnings is not None and isinstance(section, spec.params):
+        problems += list(spec.warnings(section))
     try:
         prepare(scenario)
     except ValueError as exc:
