@@ -54,6 +54,10 @@ class TuneResult:
         The best gains' score on the validation split (NaN when it was not flown).
     study : str
         The Optuna storage URL.
+    runs_per_trial : int
+        Runs of the split one trial flies (the budget is trials x runs_per_trial).
+    outputs : dict
+        Paths written: ``preset``, ``results``, ``report``.
     """
 
     controller: dict
@@ -71,6 +75,8 @@ class TuneResult:
     best_score: float = math.nan
     validation_score: float = math.nan
     study: str = ""
+    runs_per_trial: int = 0
+    outputs: dict = field(default_factory=dict)
 
 
 def controller_base(controller: str) -> dict:
@@ -259,7 +265,12 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
         ev = evaluate(st, split_specs(st, candidate_table(base, res.best_params), "validation"),
                       workers=workers, backend=backend)
         res.validation_score = ev.score
-    del probe
+    res.runs_per_trial = len(probe)
+    from .outputs import write_outputs
+
+    vehicle = str(st.file.base.get("vehicle.preset", "paper"))
+    res.outputs = write_outputs(res, out, vehicle=vehicle, suite_name=st.name, sampler=sampler, seed=seed,
+                                runs_per_trial=len(probe))
     return res
 
 

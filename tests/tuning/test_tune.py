@@ -13,9 +13,7 @@ from auvtrack.tuning import study as study_mod
 from auvtrack.tuning.objective import candidate_table, split_specs
 from tiny_suite import TINY
 
-SPLITS = ("[splits.training]\nseeds = [10, 12]\ntasks = [\"line\"]\n"
-          "[splits.validation]\nseeds = [20, 21]\ntasks = [\"line\"]\n"
-          "[run_score.weights]\nrmse = 1.0\nenergy = 0.1\n[run_score.scales]\nrmse = 0.5\nenergy = 100.0\n")
+from tuning_suite import SPLITS
 
 
 @pytest.fixture(scope="module")
