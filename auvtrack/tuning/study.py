@@ -237,11 +237,13 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
             # scored as the benchmark scores a refused set-up: every run failed at t = 0
             trial.set_user_attr("violations", len(problems))
             trial.set_user_attr("constraint", problems)
-            trial.set_constraint("setup", float(len(problems)))
+            if sampler == "tpe":  # CMA-ES has no constraint handling: it sees the failure score only
+                trial.set_constraint("setup", float(len(problems)))
             study.tell(trial, cap + 2.0)
         else:
             trial.set_user_attr("violations", 0)
-            trial.set_constraint("setup", 0.0)
+            if sampler == "tpe":
+                trial.set_constraint("setup", 0.0)
 
             def report(ev, trial=trial):
                 trial.report(ev.score, ev.runs)

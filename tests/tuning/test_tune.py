@@ -91,3 +91,24 @@ def test_a_candidate_breaking_a_setup_condition_is_a_failed_trial(suite_path, tm
     assert res.refused == 1 and res.complete == 0 and res.runs == 0
     assert t.value == load_suite(suite_path).file.run_score.cap + 2.0
     assert any("controller.ki" in p for p in t.user_attrs["constraint"])
+
+
+def test_a_failing_candidate_stops_after_the_first_batch_with_a_failure(suite_path):
+    from auvtrack.tuning.objective import evaluate
+
+    st = load_suite(suite_path)
+    bad = split_specs(st, {"kind": "pid", "kp": 0.1, "kd": 0.1, "ki": 20.0}, "training")  # set-up refused
+    ev = evaluate(st, bad, chunk=2, stop_on_failure=True)
+    assert ev.stopped_early and ev.runs == 2 and ev.failed == 2 and len(bad) == 4
+    assert ev.score == st.file.run_score.cap + 2.0  # the benchmark's score of a refused set-up
+    assert evaluate(st, bad, chunk=2).runs == 4  # without pruning every run is flown
+
+
+def test_cmaes_sampler_runs_and_stays_in_the_space(suite_path, tmp_path):
+    from auvtrack.control import CONTROLLERS
+    from auvtrack.tuning import search_space
+
+    tune("ftsmc", suite_path, trials=2, out=tmp_path / "cma", sampler="cmaes", seed=1, validate=False)
+    space = search_space(CONTROLLERS["ftsmc"].params)
+    for _, params, _ in _trials(tmp_path / "cma"):
+        assert set(params) == set(space) and all(space[k].contains(v) for k, v in params.items())
