@@ -255,6 +255,10 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
             trial.set_user_attr("runs", ev.runs)
             trial.set_user_attr("steps", ev.steps)
             trial.set_user_attr("failed_runs", ev.failed)
+            first = next((r for r in ev.rows if r["status"] != "ok"), None)
+            if first is not None:  # why the candidate failed: the mechanism, for the report
+                trial.set_user_attr("first_failure", {k: first[k] for k in ("task", "tier", "seed_index", "cause",
+                                                                             "detail", "t_stop")})
             if ev.stopped_early:
                 study.tell(trial, state=optuna.trial.TrialState.PRUNED)
             else:
