@@ -140,15 +140,43 @@ def _open_study(out: Path, sampler: str, seed: int):
     return study, url
 
 
+def _owner() -> str:
+    import os
+    import socket
+
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def _alive(owner: str) -> bool:
+    """Whether the process ``host:pid`` that asked a trial still runs (another host's: assumed alive)."""
+    import os
+    import socket
+
+    host, _, pid = owner.rpartition(":")
+    if host != socket.gethostname() or not pid.isdigit():
+        return bool(owner)
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 def _requeue_interrupted(study) -> None:
-    """Trials a stop left running: failed, and their gains asked again first (nothing lost or counted twice)."""
-    import optuna
+    """Trials a stopped process left running: failed, and their gains asked again first.
+
+    Only trials whose process has ended are taken back: another process adding trials to the
+    same study keeps its running ones (nothing lost, nothing counted twice).
+    """
     from optuna.trial import TrialState
 
     for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
+        if _alive(str(t.user_attrs.get("owner", ""))):
+            continue
         study._storage.set_trial_state_values(t._trial_id, TrialState.FAIL)
         study.enqueue_trial(t.params, user_attrs={"requeued_from": t.number}, skip_if_exists=False)
-    _ = optuna  # the import documents where TrialState lives
 
 
 def _finished(study) -> list:
@@ -227,6 +255,7 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
     while len(_finished(study)) < trials:
         study.sampler = _sampler(sampler, seed + len(_finished(study)))
         trial = study.ask(dists)
+        trial.set_user_attr("owner", _owner())
         gains = dict(trial.params)
         table = candidate_table(base, gains)
         specs = split_specs(st, table, split)

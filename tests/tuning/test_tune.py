@@ -112,3 +112,24 @@ def test_cmaes_sampler_runs_and_stays_in_the_space(suite_path, tmp_path):
     space = search_space(CONTROLLERS["ftsmc"].params)
     for _, params, _ in _trials(tmp_path / "cma"):
         assert set(params) == set(space) and all(space[k].contains(v) for k, v in params.items())
+
+
+def test_a_running_trial_of_a_live_process_is_not_taken_back(tmp_path):
+    import os
+    import socket
+
+    import optuna
+
+    folder = tmp_path / "live"
+    folder.mkdir()
+    url = f"sqlite:///{folder / study_mod.STUDY_FILE}"
+    s = optuna.create_study(study_name=study_mod.STUDY_NAME, storage=url)
+    live = s.ask({"x": optuna.distributions.FloatDistribution(0, 1)})
+    live.set_user_attr("owner", f"{socket.gethostname()}:{os.getpid()}")
+    dead = s.ask({"x": optuna.distributions.FloatDistribution(0, 1)})
+    dead.set_user_attr("owner", f"{socket.gethostname()}:{2**22 + 12345}")  # above pid_max: no such process
+    study_mod._requeue_interrupted(s)
+    states = {t.number: t.state.name for t in s.get_trials()}
+    assert states[live.number] == "RUNNING" and states[dead.number] == "FAIL"
+    waiting = [t for t in s.get_trials() if t.state.name == "WAITING"]
+    assert len(waiting) == 1 and s.ask({"x": optuna.distributions.FloatDistribution(0, 1)}).params == dead.params  # asked again with the same gains
