@@ -135,6 +135,11 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
                              ["validation-split score", res.validation_score]])
     rep.heading("Best gains")
     rep.table(["gain", "value", "importance"], [[k, v, importances.get(k, math.nan)] for k, v in res.best_params.items()])
+    if res.validation_runs:
+        rep.heading("The best gains' validation runs")
+        rep.table(["task", "tier", "seed index", "status", "cause", "t_stop (s)", "score"],
+                  [[r["task"], r["tier"], r["seed_index"], r["status"], r["cause"], r["t_stop"], r["score"]]
+                   for r in res.validation_runs])
     rep.heading("Optimisation history")
     best, rows = math.inf, []
     for t in trials:

@@ -56,6 +56,8 @@ class TuneResult:
         The Optuna storage URL.
     runs_per_trial : int
         Runs of the split one trial flies (the budget is trials x runs_per_trial).
+    validation_runs : list of dict
+        The best gains' validation runs: task, tier, seed index, status, cause, t_stop, score.
     outputs : dict
         Paths written: ``preset``, ``results``, ``report``.
     """
@@ -76,6 +78,7 @@ class TuneResult:
     validation_score: float = math.nan
     study: str = ""
     runs_per_trial: int = 0
+    validation_runs: list = field(default_factory=list)
     outputs: dict = field(default_factory=dict)
 
 
@@ -300,6 +303,8 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
         ev = evaluate(st, split_specs(st, candidate_table(base, res.best_params), "validation"),
                       workers=workers, backend=backend)
         res.validation_score = ev.score
+        res.validation_runs = [{**{k: r[k] for k in ("task", "tier", "seed_index", "status", "cause", "t_stop")},
+                                "score": sc} for r, sc in zip(ev.rows, ev.scores)]
     res.runs_per_trial = len(probe)
     from .outputs import write_outputs
 

@@ -43,6 +43,9 @@ def test_the_preset_is_usable_as_controller_preset(tuned, monkeypatch):
     sc = load_scenario(paper_scenario_path(), ['controller={kind="pid", preset="pid_remus100_tiny"}'])
     assert sc.controller.kp == preset.gains["kp"]
     assert (out / "report.html").is_file() and len(results["trials"]) == 3
+    val = results["result"]["validation_runs"]  # the best gains' runs on [splits.validation]: line x 2 tiers x 1 seed
+    assert [(r["task"], r["seed_index"]) for r in val] == [("line", 20), ("line", 20)]
+    assert "validation runs" in (out / "report.md").read_text()
 
 
 @pytest.mark.parametrize("args, field", [
