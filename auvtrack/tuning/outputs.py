@@ -119,7 +119,10 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
                   "train_score": res.best_score, "validation_score": res.validation_score,
                   "complete": res.complete, "pruned": res.pruned, "refused": res.refused,
                   "runs_flown": res.runs, "rk4_steps": res.steps, "cpu_s": round(res.cpu_s, 3),
-                  "wall_s": round(res.wall_s, 3), "tuned": list(res.best_params)}
+                  "wall_s": round(res.wall_s, 3), "study_runs": res.study_cost.get("runs", 0),
+                  "study_rk4_steps": res.study_cost.get("steps", 0),
+                  "study_cpu_s": round(res.study_cost.get("cpu_s", 0.0), 3),
+                  "study_wall_s": round(res.study_cost.get("wall_s", 0.0), 3), "tuned": list(res.best_params)}
     paths: dict[str, Path] = {}
     if res.best_params:
         name = preset_name(res.controller, vehicle, suite_name)

@@ -56,6 +56,9 @@ class TuneResult:
         The Optuna storage URL.
     runs_per_trial : int
         Runs of the split one trial flies (the budget is trials x runs_per_trial).
+    study_cost : dict
+        Runs, RK4 steps, CPU and wall seconds summed over every finished trial of the study (all
+        the processes that added to it; trials recorded before this accounting existed excluded).
     validation_runs : list of dict
         The best gains' validation runs: task, tier, seed index, status, cause, t_stop, score.
     outputs : dict
@@ -78,6 +81,7 @@ class TuneResult:
     validation_score: float = math.nan
     study: str = ""
     runs_per_trial: int = 0
+    study_cost: dict = field(default_factory=dict)
     validation_runs: list = field(default_factory=list)
     outputs: dict = field(default_factory=dict)
 
@@ -259,6 +263,7 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
         study.sampler = _sampler(sampler, seed + len(_finished(study)))
         trial = study.ask(dists)
         trial.set_user_attr("owner", _owner())
+        w0, c0 = time.perf_counter(), time.process_time()
         gains = dict(trial.params)
         table = candidate_table(base, gains)
         specs = split_specs(st, table, split)
@@ -291,6 +296,8 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
             if first is not None:  # why the candidate failed: the mechanism, for the report
                 trial.set_user_attr("first_failure", {k: first[k] for k in ("task", "tier", "seed_index", "cause",
                                                                              "detail", "t_stop")})
+            trial.set_user_attr("wall_s", time.perf_counter() - w0)
+            trial.set_user_attr("cpu_s", time.process_time() - c0)
             if ev.stopped_early:
                 study.tell(trial, state=optuna.trial.TrialState.PRUNED)
             else:
@@ -322,6 +329,7 @@ def _summarise(study, res: TuneResult) -> None:
     res.complete = sum(t.state == TrialState.COMPLETE and not t.user_attrs.get("violations") for t in done)
     res.refused = sum(bool(t.user_attrs.get("violations")) for t in done)
     res.pruned = sum(t.state == TrialState.PRUNED for t in done)
+    res.study_cost = {k: sum(t.user_attrs.get(k, 0) for t in done) for k in ("runs", "steps", "cpu_s", "wall_s")}
     ok = [t for t in done if t.state == TrialState.COMPLETE and not t.user_attrs.get("violations")]
     if ok:
         best = min(ok, key=lambda t: (t.value, t.number))

@@ -76,6 +76,9 @@ def test_a_resumed_tuning_reaches_the_trials_of_an_uninterrupted_one(suite_path,
     tune("pid", suite_path, trials=4, out=tmp_path / "b", seed=7, validate=False)
     full = _trials(tmp_path / "a")
     assert len(full) == 4 and _trials(tmp_path / "b") == full
+    resumed = tune("pid", suite_path, trials=4, out=tmp_path / "b", seed=7, validate=False)  # nothing left to do
+    again = tune("pid", suite_path, trials=4, out=tmp_path / "a", seed=7, validate=False)
+    assert resumed.runs == 0 and resumed.study_cost["runs"] == again.study_cost["runs"] > 0
 
 
 def test_a_candidate_breaking_a_setup_condition_is_a_failed_trial(suite_path, tmp_path):
