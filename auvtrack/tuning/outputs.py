@@ -121,8 +121,8 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
                   "runs_flown": res.runs, "rk4_steps": res.steps, "cpu_s": round(res.cpu_s, 3),
                   "wall_s": round(res.wall_s, 3), "study_runs": res.study_cost.get("runs", 0),
                   "study_rk4_steps": res.study_cost.get("steps", 0),
-                  "study_cpu_s": round(res.study_cost.get("cpu_s", 0.0), 3),
-                  "study_wall_s": round(res.study_cost.get("wall_s", 0.0), 3), "tuned": list(res.best_params)}
+                  **{f"study_{k}": round(res.study_cost[k], 3) for k in ("cpu_s", "wall_s") if k in res.study_cost},
+                  "tuned": list(res.best_params)}
     paths: dict[str, Path] = {}
     if res.best_params:
         name = preset_name(res.controller, vehicle, suite_name)

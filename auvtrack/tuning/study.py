@@ -329,7 +329,8 @@ def _summarise(study, res: TuneResult) -> None:
     res.complete = sum(t.state == TrialState.COMPLETE and not t.user_attrs.get("violations") for t in done)
     res.refused = sum(bool(t.user_attrs.get("violations")) for t in done)
     res.pruned = sum(t.state == TrialState.PRUNED for t in done)
-    res.study_cost = {k: sum(t.user_attrs.get(k, 0) for t in done) for k in ("runs", "steps", "cpu_s", "wall_s")}
+    res.study_cost = {k: sum(t.user_attrs.get(k, 0) for t in done) for k in ("runs", "steps", "cpu_s", "wall_s")
+                      if k in ("runs", "steps") or any(k in t.user_attrs for t in done)}
     ok = [t for t in done if t.state == TrialState.COMPLETE and not t.user_attrs.get("violations")]
     if ok:
         best = min(ok, key=lambda t: (t.value, t.number))
