@@ -47,7 +47,7 @@ from pydantic import Field
 from ..jit import njit, njit_noalloc
 from ..packing import packed_layout
 from .gain_checks import require
-from .registry import CompiledController, ControllerParams
+from .registry import CompiledController, ControllerParams, tunable
 from .saturation import COMPENSATED, SATURATION, accel_deficit, code
 from .tracking import error_state_forces, input_for_accel_forces
 
@@ -62,13 +62,13 @@ class Params(ControllerParams):
     """Backstepping on (e, e_dot) with an optional adaptive estimate of the lumped disturbance (eq. B1-B4)."""
 
     kind: Literal["backstepping"] = "backstepping"
-    c1: float = Field(1.0, gt=0, description="first-step gain, 1/s")
-    c2: float = Field(2.0, gt=0, description="second-step gain, 1/s")
+    c1: float = tunable(1.0, 0.01, 20.0, log=True, gt=0, description="first-step gain, 1/s")
+    c2: float = tunable(2.0, 0.01, 20.0, log=True, gt=0, description="second-step gain, 1/s")
     adaptive: bool = Field(True, description="estimate a bias b_hat of the lumped disturbance (eq. B3)")
-    gamma: float = Field(2.0, gt=0, description="adaptation gain, 1/s^2 (used when adaptive)")
-    sigma: float = Field(0.0, ge=0, description="leakage of b_hat (sigma-modification), 1/s")
+    gamma: float = tunable(2.0, 1e-4, 50.0, log=True, gt=0, description="adaptation gain, 1/s^2 (used when adaptive)")
+    sigma: float = tunable(0.0, 0.0, 1.0, ge=0, description="leakage of b_hat (sigma-modification), 1/s")
     k0: float = Field(1.0, gt=0, description="weight of z1 in V, 1/s^2 (1: the published law)")
-    kaw: float = Field(1.0, ge=0, description="back-calculation gain of b_hat (saturation = 'compensated'), 1/s")
+    kaw: float = tunable(1.0, 0.01, 10.0, log=True, ge=0, description="back-calculation gain of b_hat (saturation = 'compensated'), 1/s")
     saturation: Literal[SATURATION] = Field(
         "published", description="'published': eq. (B3); 'compensated': b_hat conditioned on the actuators' "
         "reach (B3c)")

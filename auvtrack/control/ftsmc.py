@@ -22,7 +22,7 @@ from pydantic import Field
 
 from ..jit import njit, njit_noalloc
 from ..packing import packed_layout
-from .registry import CompiledController, ControllerParams
+from .registry import CompiledController, ControllerParams, tunable
 from .tracking import error_state_forces, input_for_accel_forces, sig_pair, sign
 
 NAME = "ftsmc"
@@ -44,10 +44,10 @@ class Params(ControllerParams):
     """
 
     kind: Literal["ftsmc"] = "ftsmc"
-    beta: float = Field(1.0, gt=0, description="weight of the terminal term, s^gamma")
-    gamma: float = Field(1.5, gt=1, lt=2, description="terminal exponent p/q, in (1, 2)")
-    k1: float = Field(0.05, ge=0, description="switching gain, m/s^2")
-    k2: float = Field(1.0, ge=0, description="linear reaching gain, 1/s")
+    beta: float = tunable(1.0, 0.01, 20.0, log=True, gt=0, description="weight of the terminal term, s^gamma")
+    gamma: float = tunable(1.5, 1.05, 1.95, gt=1, lt=2, description="terminal exponent p/q, in (1, 2)")
+    k1: float = tunable(0.05, 1e-4, 1.0, log=True, ge=0, description="switching gain, m/s^2")
+    k2: float = tunable(1.0, 0.01, 20.0, log=True, ge=0, description="linear reaching gain, 1/s")
 
 
 

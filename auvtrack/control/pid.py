@@ -33,7 +33,7 @@ from typing import Literal
 from ..jit import njit, njit_noalloc
 from ..packing import packed_layout
 from .gain_checks import require
-from .registry import CompiledController, ControllerParams
+from .registry import CompiledController, ControllerParams, tunable
 from .saturation import COMPENSATED, SATURATION, accel_deficit, code
 from .tracking import error_state_forces, input_for_accel_forces
 
@@ -51,10 +51,10 @@ class Params(ControllerParams):
     """
 
     kind: Literal["pid"] = "pid"
-    kp: float = Field(3.0, gt=0, description="proportional gain, 1/s^2")
-    ki: float = Field(1.0, ge=0, description="integral gain, 1/s^3 (0: PD); ki < kd kp")
-    kd: float = Field(3.0, gt=0, description="derivative gain, 1/s")
-    kaw: float = Field(1.0, ge=0, description="back-calculation (anti-windup) gain 1/T_t, 1/s")
+    kp: float = tunable(3.0, 0.01, 30.0, log=True, gt=0, description="proportional gain, 1/s^2")
+    ki: float = tunable(1.0, 1e-5, 30.0, log=True, ge=0, description="integral gain, 1/s^3 (0: PD); ki < kd kp")
+    kd: float = tunable(3.0, 0.05, 30.0, log=True, gt=0, description="derivative gain, 1/s")
+    kaw: float = tunable(1.0, 0.01, 10.0, log=True, ge=0, description="back-calculation (anti-windup) gain 1/T_t, 1/s")
     saturation: Literal[SATURATION] = Field(
         "compensated", description="'compensated': back-calculation from the actuators' reach (eq. P2); "
         "'published': the textbook PID, I_dot = e")

@@ -56,7 +56,7 @@ from pydantic import Field
 from ..jit import njit, njit_noalloc
 from ..packing import packed_layout
 from .gain_checks import fmt, require
-from .registry import CompiledController, ControllerParams
+from .registry import CompiledController, ControllerParams, tunable
 from .saturation import COMPENSATED, SATURATION, accel_deficit, code
 from .tracking import error_state_forces, input_for_accel_forces
 
@@ -81,12 +81,12 @@ class Params(ControllerParams):
     """
 
     kind: Literal["ppc"] = "ppc"
-    kp: float = Field(16.0, gt=0, description="gain on eps, 1/s^2")
-    kd: float = Field(8.0, gt=0, description="gain on eps_dot, 1/s")
-    l: float = Field(0.3, gt=0, description="envelope decay rate, 1/s")
+    kp: float = tunable(16.0, 0.01, 200.0, log=True, gt=0, description="gain on eps, 1/s^2")
+    kd: float = tunable(8.0, 0.05, 50.0, log=True, gt=0, description="gain on eps_dot, 1/s")
+    l: float = tunable(0.3, 0.01, 2.0, log=True, gt=0, description="envelope decay rate, 1/s")
     rho0: tuple[Pos, Pos, Pos] = Field((5.0, 1.5, 1.0), description="rho(0) per axis, m")
     rho_inf: tuple[Pos, Pos, Pos] = Field((0.005, 0.005, 0.005), description="rho(inf) per axis, m")
-    k_aux: float = Field(1.0, gt=0, description="rate of the auxiliary system (R5), 1/s (saturation = 'compensated')")
+    k_aux: float = tunable(1.0, 0.01, 10.0, log=True, gt=0, description="rate of the auxiliary system (R5), 1/s (saturation = 'compensated')")
     saturation: Literal[SATURATION] = Field(
         "published", description="'published': eq. (R4); 'compensated': the envelope on the error less the "
         "auxiliary system's response to what the actuators could not produce (R5)-(R6)")

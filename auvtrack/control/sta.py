@@ -49,7 +49,7 @@ from pydantic import Field
 from ..jit import njit, njit_noalloc
 from ..packing import packed_layout
 from .gain_checks import require
-from .registry import CompiledController, ControllerParams
+from .registry import CompiledController, ControllerParams, tunable
 from .saturation import COMPENSATED, SATURATION, accel_deficit, code
 from .tracking import error_state_forces, input_for_accel_forces, sign
 
@@ -68,13 +68,13 @@ class Params(ControllerParams):
     """
 
     kind: Literal["sta"] = "sta"
-    lam: float = Field(1.0, gt=0, description="sliding-surface slope, 1/s")
-    k1: float = Field(1.0, gt=0, description="gain of |s|^(1/2) sign(s), m^(1/2)/s^(3/2)")
-    k2: float = Field(0.5, gt=0, description="gain of the integrated sign(s), m/s^3")
+    lam: float = tunable(1.0, 0.01, 20.0, log=True, gt=0, description="sliding-surface slope, 1/s")
+    k1: float = tunable(1.0, 0.01, 20.0, log=True, gt=0, description="gain of |s|^(1/2) sign(s), m^(1/2)/s^(3/2)")
+    k2: float = tunable(0.5, 0.001, 20.0, log=True, gt=0, description="gain of the integrated sign(s), m/s^3")
     L: float = Field(0.1, ge=0, description="assumed bound on |d chi/dt|, m/s^3")
     gain_condition: Literal["moreno_osorio", "levant", "none"] = Field(
         "moreno_osorio", description="which finite-time condition setup checks: (S5), (S4), or none")
-    kaw: float = Field(1.0, ge=0, description="back-calculation gain of the integral (saturation = 'compensated'), 1/s")
+    kaw: float = tunable(1.0, 0.01, 10.0, log=True, ge=0, description="back-calculation gain of the integral (saturation = 'compensated'), 1/s")
     saturation: Literal[SATURATION] = Field(
         "published", description="'published': eq. (S3); 'compensated': the integral conditioned on the "
         "actuators' reach (S3c)")

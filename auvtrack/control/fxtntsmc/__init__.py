@@ -56,7 +56,7 @@ from ...jit.vecmath import atanh4, pow4
 from ...packing import packed_layout
 from . import envelopes
 from . import rbf
-from ..registry import CompiledController, ControllerParams
+from ..registry import CompiledController, ControllerParams, tunable
 from ..contract import WORK_SIZE
 from ..saturation import COMPENSATED, SATURATION, accel_deficit, code
 from ..tracking import error_state_forces, input_for_accel_forces, sign
@@ -93,14 +93,14 @@ class Params(ControllerParams):
     """
 
     kind: Literal["fxtntsmc"] = "fxtntsmc"
-    kappa1: float = Field(0.005, gt=0, description="switching gain")
-    kappa2: float = Field(0.8, gt=0, description="cubic reaching gain")
-    kappa3: float = Field(0.6, gt=0, description="linear reaching gain")
-    a1: float = Field(0.8, gt=0)
-    a2: float = Field(0.8, gt=0, lt=1, description="fractional power, 0.5 <= a2 < 1 in Theorem 1")
-    a3: float = Field(0.8, gt=0, description="b1 of Theorem 1")
-    a4: float = Field(2.0, gt=1, description="b2 of Theorem 1")
-    alpha: float = Field(0.6, gt=0)
+    kappa1: float = tunable(0.005, 1e-4, 1.0, log=True, gt=0, description="switching gain")
+    kappa2: float = tunable(0.8, 0.01, 20.0, log=True, gt=0, description="cubic reaching gain")
+    kappa3: float = tunable(0.6, 0.01, 20.0, log=True, gt=0, description="linear reaching gain")
+    a1: float = tunable(0.8, 0.01, 20.0, log=True, gt=0)
+    a2: float = tunable(0.8, 0.5, 0.99, gt=0, lt=1, description="fractional power, 0.5 <= a2 < 1 in Theorem 1")
+    a3: float = tunable(0.8, 0.01, 20.0, log=True, gt=0, description="b1 of Theorem 1")
+    a4: float = tunable(2.0, 1.05, 5.0, gt=1, description="b2 of Theorem 1")
+    alpha: float = tunable(0.6, 0.5, 1.2, gt=0)
     sigma: float = Field(0.005, gt=0, description="switch threshold of eq. (27)")
     varsigma1: float = Field(0.05, gt=0, description="RBF approximation-error bound (Theorem 1)")
     surface: Literal["nonsingular", "printed"] = Field(
@@ -110,7 +110,7 @@ class Params(ControllerParams):
     )
     z_switch: float = Field(0.01, gt=0, description="|z| below which the nonsingular switch is used")
     z_floor: float = Field(1e-6, gt=0, description="floor on |z| in the printed form's |z|^(a2-1)")
-    k_aux: float = Field(1.0, gt=0, description="rate of the auxiliary system (C1), 1/s (saturation = 'compensated')")
+    k_aux: float = tunable(1.0, 0.01, 10.0, log=True, gt=0, description="rate of the auxiliary system (C1), 1/s (saturation = 'compensated')")
     saturation: Literal[SATURATION] = Field(
         "published", description="'published': eq. (26)-(34); 'compensated': the law on the error less the "
         "auxiliary system's response to what the actuators could not produce (C1)-(C2)")

@@ -1,0 +1,49 @@
+"""``auvtrack tune``: tune one controller's gains on a suite's training split (docs/tuning.md)."""
+from __future__ import annotations
+
+import click
+
+from .common import EXIT_CODES_HELP, EXIT_INTERRUPTED, BadInput, cli, one_line
+from .signals import stop_once
+
+
+@cli.command(epilog=EXIT_CODES_HELP)
+@click.option("--controller", required=True, metavar="KIND|FILE.py",
+              help="A built-in tracking controller or a plug-in file; its Params declare the gains searched.")
+@click.option("--suite", "suite_name", default="auv-track-v1", show_default=True, metavar="NAME",
+              help="A shipped suite or a suite TOML file; its [splits.training] seeds are flown.")
+@click.option("--budget", type=int, required=True, metavar="TRIALS",
+              help="Trials (each flies every run of the training split: budget = trials x training runs).")
+@click.option("--out", type=click.Path(file_okay=False), required=True,
+              help="Output folder: study.db (resumed when present), the preset, results.json, report.html.")
+@click.option("--sampler", type=click.Choice(["tpe", "cmaes"]), default="tpe", show_default=True)
+@click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed.")
+@click.option("--workers", type=click.IntRange(1, 256), default=1, show_default=True,
+              help="Threads of the batch runner inside a trial.")
+@click.option("--backend", default=None, metavar="NAME", help="Back end of the batch runner.")
+@click.option("--no-validate", is_flag=True, help="Do not fly the best gains on the validation split.")
+@click.option("--quiet", is_flag=True, help="No progress line.")
+def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, seed: int, workers: int,
+         backend: str | None, no_validate: bool, quiet: bool) -> None:
+    """Tune a controller for the suite's vehicle with Optuna; Ctrl-C keeps the study, run again to resume."""
+    from ..benchmark.suite import SuiteError
+    from ..tuning import tune as _tune
+
+    def progress(done: int, total: int) -> None:
+        if not quiet:
+            click.echo(f"trial {done}/{total}", err=True)
+
+    with stop_once():
+        try:
+            res = _tune(controller, suite_name, trials=budget, out=out, sampler=sampler, seed=seed,
+                        validate=not no_validate, workers=workers, backend=backend, progress=progress)
+        except (SuiteError, ValueError) as exc:
+            raise BadInput(one_line(exc)) from None
+        except KeyboardInterrupt:
+            click.echo(f"auvtrack: interrupted; the study in {out} resumes with the same command", err=True)
+            raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
+    click.echo(f"trials: {res.trials} ({res.complete} complete, {res.pruned} pruned, {res.refused} refused); "
+               f"runs: {res.runs}; RK4 steps: {res.steps}; CPU {res.cpu_s:.1f} s; wall {res.wall_s:.1f} s")
+    click.echo(f"best training score: {res.best_score:.6g}; validation-split score: {res.validation_score:.6g}")
+    for k, p in res.outputs.items():
+        click.echo(f"{k}: {p}")
