@@ -86,3 +86,17 @@ def test_the_feasibility_flag_is_not_part_of_the_fingerprint(tmp_path):
     a = load_suite(_one_cell(tmp_path / "a", 60.0), check=False).fingerprint()
     b = load_suite(_one_cell(tmp_path / "b", 60.0, feasibility=False), check=False).fingerprint()
     assert a != "" and a == b
+
+
+def test_v2_run_score_puts_path_following_first_by_hand():
+    """A completed run at the scales of xtrack, vtrack, along and rmse, no actuator use:
+    (1 * 0.5 + 0.5 * 1 + 0.25 * 1 + 0.25 * 1) / (sum of the weights, 2.4) = 0.625."""
+    suite = load_suite("auv-track-v2", check=False)
+    zero = {c: 0.0 for c in suite.file.run_score.weights}
+    run = zero | {"status": "ok", "t_stop": 120.0, "xtrack_rmse": 0.25, "vtrack_rmse": 0.5, "along_rmse": 2.0,
+                  "rmse": 1.0}
+    assert suite.run_score(run, "helix") == pytest.approx(1.5 / 2.4, rel=1e-12)
+    weights = suite.file.run_score.weights
+    assert max(weights, key=weights.get) == "xtrack_rmse"
+    worse = run | {"xtrack_rmse": 0.5}
+    assert suite.run_score(worse, "helix") - suite.run_score(run, "helix") == pytest.approx(0.5 / 2.4, rel=1e-12)
