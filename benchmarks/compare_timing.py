@@ -1,6 +1,7 @@
 """Wall time of ``auvtrack compare`` on this machine: ``--quick`` and the default suite, after compilation.
 
-Usage: ``python benchmarks/compare_timing.py [--skip-default] [--workers N] [--out DIR] [--backend B ...]``.
+Usage: ``python benchmarks/compare_timing.py [--suite NAME] [--skip-default] [--workers N] [--out DIR] [--backend B ...]``
+(another suite than the default writes ``compare_timing-<suite>.{json,md}``).
 
 A first ``--quick`` comparison compiles every kernel the disk cache lacks, or loads it, and is timed as
 "cold" (its compile/load column says which happened); then, in the
@@ -27,14 +28,16 @@ import pandas as pd
 
 from auvtrack import __version__
 from auvtrack.benchmark.compare import compare
+from auvtrack.benchmark.suite import DEFAULT_SUITE
 
 HERE = Path(__file__).resolve().parent
 TARGETS = {"quick (cold)": None, "quick": 120.0, "default": 900.0}  # s after compilation, issue 16
 
 
-def _one(label: str, out: Path, quick: bool, workers: int | None, backend: str = "threads") -> dict:
+def _one(label: str, out: Path, quick: bool, workers: int | None, backend: str = "threads",
+         suite: str = DEFAULT_SUITE) -> dict:
     t0 = time.perf_counter()
-    res = compare(quick=quick, out=out, workers=workers, progress=True, backend=backend)
+    res = compare(suite=suite, quick=quick, out=out, workers=workers, progress=True, backend=backend)
     wall = time.perf_counter() - t0
     doc = json.loads((out / "results.json").read_text())
     timing = doc["timing"]
@@ -91,20 +94,23 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=None, help="folder of the comparisons (default: a new temp dir)")
     ap.add_argument("--backend", action="append", default=None,
                     help="batch back end of the comparisons (repeatable; default: threads)")
+    ap.add_argument("--suite", default=DEFAULT_SUITE, help="suite to time (default: the default suite)")
     args = ap.parse_args()
     root = args.out or Path(tempfile.mkdtemp(prefix="auvtrack-compare-timing-"))
     rows = []
     for be in args.backend or ["threads"]:
-        rows += [_one("quick (cold)", root / be / "quick-cold", True, args.workers, be),
-                 _one("quick", root / be / "quick", True, args.workers, be)]
+        rows += [_one("quick (cold)", root / be / "quick-cold", True, args.workers, be, args.suite),
+                 _one("quick", root / be / "quick", True, args.workers, be, args.suite)]
         if not args.skip_default:
-            rows.append(_one("default", root / be / "default", False, args.workers, be))
+            rows.append(_one("default", root / be / "default", False, args.workers, be, args.suite))
     doc = {"measured": dt.datetime.now(dt.timezone.utc).isoformat(timespec="minutes"),
            "machine": f"{platform.machine()} / {_cpu()} / Python "
                       f"{platform.python_version()}", "cpu_count": os.cpu_count(), "version": __version__,
            "rows": rows}
-    (HERE / "compare_timing.json").write_text(json.dumps(doc, indent=2) + "\n")
-    (HERE / "compare_timing.md").write_text(_markdown(doc))
+    stem = "compare_timing" if args.suite == DEFAULT_SUITE else f"compare_timing-{Path(args.suite).stem}"
+    doc["suite"] = args.suite
+    (HERE / f"{stem}.json").write_text(json.dumps(doc, indent=2) + "\n")
+    (HERE / f"{stem}.md").write_text(_markdown(doc))
     print(_markdown(doc))
 
 

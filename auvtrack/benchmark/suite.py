@@ -288,6 +288,7 @@ class SuiteFile(_Model):
     tiers: Annotated[dict[str, Tier], Field(min_length=1)]
     splits: Splits = Field(default_factory=Splits)
     run_score: RunScore = Field(default_factory=RunScore)
+    feasibility: Annotated[bool, Strict()] = Field(False, description="assess every cell's feasibility at load")
 
     @model_validator(mode="after")
     def _names(self) -> "SuiteFile":
@@ -792,6 +793,7 @@ class Suite:
         """SHA-256 of everything that defines the runs (the file's contents and the variant)."""
         suite = self.file.model_dump(mode="json")
         suite.pop("splits")  # tuning seeds: they define no run of the comparison
+        suite.pop("feasibility")  # a check at load: it defines no run either
         doc = {"suite": suite, "quick": self.quick, "skipped": list(self._skipped)}
         return hashlib.sha256(json.dumps(doc, sort_keys=True, default=str).encode()).hexdigest()
 
@@ -918,6 +920,7 @@ def _check_runs(suite: Suite) -> None:
             _check_starts(suite, task, tier)
             _, ov, _ = suite.conditions(task, tier, 0)
             fixed = {k: v for k, v in ov.items() if k not in tr.random and k not in tr.cycle}
+            fixed |= {k: options[0] for k, options in tr.cycle.items()}  # a cycled key always has a value
             prep = _prepared_probe(suite, entries, task, tier, "set", fixed)
             for key, options in tr.cycle.items():
                 for j, v in enumerate(options):
@@ -930,6 +933,42 @@ def _check_runs(suite: Suite) -> None:
                     except ScenarioError as exc:
                         raise SuiteError(f"{suite.source}: tiers.{tier}.random.{key}: on task {task!r} {what} "
                                          f"{v:g} is refused: {_reason(exc)}") from None
+
+
+def _worst_draws(tier: Tier) -> list[dict[str, float]]:
+    """Every corner of a tier's random ranges (a normal at mean +- :data:`NORMAL_PROBE_STD` std)."""
+    keys = list(tier.random)
+    ends = [[v for what, v in _probe_values(tier.random[k]) if what != "the mean"] or
+            [v for _, v in _probe_values(tier.random[k])] for k in keys]
+    return [dict(zip(keys, combo)) for combo in itertools.product(*ends)] if keys else [{}]
+
+
+def _check_feasibility(suite: Suite) -> None:
+    """Refuse a (task, tier) cell whose plant cannot fly the task's reference (:mod:`auvtrack.feasibility`).
+
+    Each cell is assessed with every cycled value and every corner of its random ranges (the
+    current at its worst); a plant without a steady-state model is not assessed.  The message
+    names the cell and the first infeasible check.
+    """
+    from ..feasibility.assess import assess
+
+    entry = resolve_controllers(None, gain_preset=suite.file.gain_preset)[0]
+    for task in suite.tasks:
+        for tier in suite.tiers:
+            tr = suite.file.tiers[tier]
+            raw, ov, _ = suite.scenario(entry, task, tier, 0)
+            fixed = {k: v for k, v in ov.items() if k not in tr.random and k not in tr.cycle}
+            cycles = [dict(zip(tr.cycle, combo)) for combo in itertools.product(*tr.cycle.values())]
+            for cyc in cycles:
+                for draw in _worst_draws(tr):
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore")
+                        verdict = assess(raw, {**fixed, **cyc, **draw})
+                    if verdict.verdict == "infeasible":
+                        bad = next(c for c in verdict.checks if c.status == "infeasible")
+                        where = ", ".join(f"{k} = {v}" for k, v in {**cyc, **draw}.items())
+                        raise SuiteError(f"{suite.source}: task {task!r} under tier {tier!r} is infeasible"
+                                         f"{' (' + where + ')' if where else ''}: {bad.describe()}")
 
 
 def load_suite(name: str | Path = DEFAULT_SUITE, *, check: bool = True) -> Suite:
@@ -991,4 +1030,6 @@ def load_suite(name: str | Path = DEFAULT_SUITE, *, check: bool = True) -> Suite
         raise SuiteError(f"{source}: tiers: none can run in this build ({'; '.join(r for _, r in skipped)})")
     if check:
         _check_runs(suite)
+        if sf.feasibility:
+            _check_feasibility(suite)
     return suite
