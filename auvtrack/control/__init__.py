@@ -20,7 +20,6 @@ BUILTIN = tuple(import_module(f"{__name__}.{name}") for name in (
     "los_autopilot",
     "open_loop",
     "open_loop_actuators",
-    "policy",
 ))
 """The built-in controller modules, in registry order (add one: its module name here)."""
 BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)

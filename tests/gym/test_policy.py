@@ -4,7 +4,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from auvtrack.control import get
 from auvtrack.control.contract import evaluate
 from auvtrack.control.policy import control, forward, load_policy, pack, save_policy
 from auvtrack.control.policy_observation import OBS, OBS_BOUND, observe
@@ -23,9 +22,11 @@ def _random_policy(tmp_path, rng, sizes=(16, 8), acts=("tanh", "relu", "identity
                                    rng.uniform(0.5, 3.0, OBS.size)))
 
 
-def test_registered_with_its_contract():
-    spec = get("policy")
-    assert spec.name == "policy"
+def test_contract_checked():
+    from auvtrack.control import check_controller
+    from auvtrack.control import policy
+
+    assert check_controller(policy, plugin=True).name == "policy"
 
 
 def test_law_equals_numpy_forward(tmp_path):
@@ -78,3 +79,30 @@ def test_law_observation_equals_environment_observation(tmp_path):
 def test_malformed_file_refused(tmp_path):
     with pytest.raises(ValueError, match="controller.file"):
         save_policy(tmp_path / "bad.npz", [np.zeros((3, 5))], [np.zeros(3)], ["tanh"], (1, 1, 1))
+
+
+def test_policy_runs_in_the_engine_as_the_env_would_fly_it(tmp_path):
+    """A policy run (controller.module = auvtrack.control.policy) == the env driven by the NumPy forward pass."""
+    from auvtrack.gym.env import episode_scenario
+    from auvtrack.scenario import load_scenario
+    from auvtrack.simulation.pipeline import simulate
+
+    rng = np.random.default_rng(11)
+    env = TrackEnv(SUITE, "helix", "calm", duration=0.5)
+    obs, _ = env.reset(seed=4)
+    pol = _random_policy(tmp_path, rng, sizes=(8,), acts=("tanh", "tanh"))
+    pol_file = save_policy(tmp_path / "run.npz", pol["weights"], pol["biases"], pol["header"]["activations"],
+                           env.scale, pol["obs_mean"], pol["obs_std"])
+    pol = load_policy(pol_file)
+    while True:
+        obs, _, te, tr, info = env.step(forward(pol, obs) / env.scale)
+        if te or tr:
+            break
+    sc = episode_scenario(SUITE, "helix", "calm", 4, duration=0.5)
+    raw = sc.to_dict()
+    raw["controller"] = {"kind": "plugin", "module": "auvtrack.control.policy", "params": {"file": str(pol_file)}}
+    res = simulate(load_scenario(raw))
+    assert res.status == "ok" and info["status"] == "ok"
+    for name in ("rmse_x", "rmse_y", "rmse_z", "energy_tau_u", "energy_tau_r"):
+        assert res.metrics[name] == pytest.approx(info["metrics"][name], rel=1e-9, abs=1e-12), name
+    assert res.metrics["energy_tau_u"] > 0
