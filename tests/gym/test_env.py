@@ -78,3 +78,17 @@ def test_episode_equals_engine_run_of_same_actions(tier):
     for j, k in enumerate(("x", "y", "z", "theta", "psi")):
         assert res.channels[k][-1] == pytest.approx(eta[j], abs=1e-12, rel=0), k
     assert res.channels["t"][-1] == pytest.approx(0.6)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("action", ["tau", "actuators"])
+def test_check_env_six_dof_truth(action):
+    """The shipped suite's 6-DOF tier, both action modes (short episodes)."""
+    env = TrackEnv("auv-track-v1", "helix", "truth6", action=action, duration=0.2)
+    check_env(env, skip_render_check=True)
+    obs, _ = env.reset(seed=0)
+    for _ in range(10):
+        obs, r, te, tr, info = env.step(np.array([0.5, 0.0, 0.1]))
+        if te or tr:
+            break
+    assert tr and info["status"] == "ok" and np.isfinite(r)
