@@ -235,7 +235,7 @@ class TrackEnv(gym.Env):
         row = int(c.ks[0, 0]) // self.ctrl_every
         base = GAINS.table + 3 * min(row, int(self.ins.cp[0, GAINS.n]) - 1)
         self.ins.cp[0, base:base + 3] = a
-        self.kernels.step_all(self.ins, c, OBS_BOUND)
+        self.kernels.step_serial(self.ins, c, OBS_BOUND)
         cause = int(c.cause[0])
         terminated = cause != 0
         truncated = (not terminated) and int(c.ks[0, 0]) >= self.n_steps

@@ -24,7 +24,10 @@ from ..engine.loop import INFO_SIZE  # noqa: F401
 from ..metrics import METRICS_SIZE, OFF_E2, OFF_TEN, OFF_TV, metrics_init
 from ..plant.contract import SCRATCH_SIZE
 
-__all__ = ["Carry", "new_carry", "step_module", "REWARD"]
+__all__ = ["Carry", "new_carry", "step_module", "REWARD", "PARALLEL_FROM"]
+
+PARALLEL_FROM = 256
+"""Envs from which a step runs in the thread pool (``step_all``) rather than in one thread (``step_serial``)."""
 
 REWARD = ("w_error", "w_energy", "w_tv", "penalty")
 """Reward weights per env (row of ``Carry.rw``): see :func:`env_step`."""
@@ -192,6 +195,13 @@ def step_all(ins, c, bound):
             env_step(ins, c, i, bound)
 
 
+def step_serial(ins, c, bound):
+    """:func:`step_all` in one thread (few envs: waking the thread pool costs more than the steps)."""
+    for i in range(c.xp.shape[0]):
+        if c.cause[i] == 0:
+            env_step(ins, c, i, bound)
+
+
 def observe_all(ins, c, bound):
     """:func:`env_observe` of every env."""
     for i in range(c.xp.shape[0]):
@@ -199,7 +209,7 @@ def observe_all(ins, c, bound):
 
 
 PARTS = {"env_step": "njit(nogil=True)", "env_observe": "njit(nogil=True)",
-         "step_all": "njit(nogil=True, parallel=True)", "observe_all": "njit(nogil=True)"}
+         "step_all": "njit(nogil=True, parallel=True)", "step_serial": "njit(nogil=True)", "observe_all": "njit(nogil=True)"}
 _LOCK = threading.Lock()
 
 

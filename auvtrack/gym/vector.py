@@ -1,4 +1,4 @@
-"""``TrackVectorEnv``: N episodes of one suite cell stepped by one compiled call (a ``prange`` over the envs).
+"""``TrackVectorEnv``: N episodes of one suite cell stepped by one compiled call (a ``prange`` over the envs from :data:`~auvtrack.gym.stepping.PARALLEL_FROM` envs, one thread below).
 
 Rows of the engine's :class:`~auvtrack.engine.loop.Stacked` inputs and of the
 :class:`~auvtrack.gym.stepping.Carry` are the envs; :meth:`step` writes the actions into the rows'
@@ -21,7 +21,7 @@ from ..control.policy_observation import OBS_BOUND
 from ..engine.loop import SI
 from .env import TrackEnv
 from .replay import GAINS
-from .stepping import new_carry
+from .stepping import PARALLEL_FROM, new_carry
 
 
 class TrackVectorEnv(VectorEnv):
@@ -119,7 +119,8 @@ class TrackVectorEnv(VectorEnv):
         ins.cp[np.arange(self.num_envs)[:, None], cols] = a
         live = ~self._done
         c.cause[~live] = -1  # the reset envs are not stepped this call
-        self.kernels.step_all(ins, c, OBS_BOUND)
+        step = self.kernels.step_all if self.num_envs >= PARALLEL_FROM else self.kernels.step_serial
+        step(ins, c, OBS_BOUND)
         c.cause[~live] = 0
         reward = np.where(live, c.reward, 0.0)
         terminated = live & (c.cause != 0)
