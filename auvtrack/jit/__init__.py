@@ -30,7 +30,8 @@ from . import vecmath as _vecmath
 
 _PKG = Path(__file__).resolve().parents[1]
 COMPILED = ("jit", "packing.py", "channels.py", "metrics.py", "fields.py", "user_modules.py", "_seeding.py",
-            "interrupt.py", "vehicle", "plant", "environment", "reference", "control", "engine")
+            "interrupt.py", "vehicle", "plant", "environment", "reference", "control", "engine",
+            "gym/stepping.py", "gym/replay.py", "gym/replay_actuators.py")
 """Packages and modules (relative to the package root) whose sources compiled code is made of."""
 
 

@@ -1,0 +1,262 @@
+"""The compiled step of the environments: one control period (ZOH, ``ctrl_every`` RK4 steps) of N runs.
+
+:func:`env_step` is the body of the engine's loop (:func:`auvtrack.engine.loop.run`, sampled-data
+mode) cut at control samples: the same stage, metrics and stop checks in the same order, so that an
+episode driven by the replay law (:mod:`auvtrack.gym.replay`) integrates the numbers of an engine
+run of the same actions.  Like the engine's parts it is plain Python here; :func:`step_module`
+writes, per plant, a module that imports the (replay, plant) kernel module and compiles a copy.
+Inputs are the engine's :class:`~auvtrack.engine.loop.Stacked` (row i = env i); the per-env state
+is a :class:`Carry`.
+"""
+from __future__ import annotations
+
+import importlib.util
+import inspect
+import sys
+import threading
+from typing import NamedTuple
+
+import numpy as np
+
+from ..control.contract import WORK_SIZE
+from ..engine import kernels
+from ..engine.loop import INFO_SIZE  # noqa: F401
+from ..metrics import METRICS_SIZE, OFF_E2, OFF_TEN, OFF_TV, metrics_init
+from ..plant.contract import SCRATCH_SIZE
+
+__all__ = ["Carry", "new_carry", "step_module", "REWARD", "PARALLEL_FROM"]
+
+PARALLEL_FROM = 256
+"""Envs from which a step runs in the thread pool (``step_all``) rather than in one thread (``step_serial``)."""
+
+REWARD = ("w_error", "w_energy", "w_tv", "penalty")
+"""Reward weights per env (row of ``Carry.rw``): see :func:`env_step`."""
+
+
+class Carry(NamedTuple):
+    """What N environments keep between steps (row i = env i)."""
+
+    xp: np.ndarray
+    xc: np.ndarray
+    cmd: np.ndarray
+    tau1: np.ndarray
+    kc1: np.ndarray
+    acc: np.ndarray
+    refm: np.ndarray
+    scr: np.ndarray
+    work: np.ndarray
+    ks: np.ndarray
+    obs: np.ndarray
+    reward: np.ndarray
+    cause: np.ndarray
+    rw: np.ndarray
+
+
+def new_carry(n: int, nxp: int, nxc: int, ncmd: int, nobs: int) -> Carry:
+    """Fresh per-env state arrays for ``n`` environments.
+
+    Parameters
+    ----------
+    n : int
+        Environments.
+    nxp, nxc, ncmd, nobs : int
+        Plant states, controller states, plant commands, observation size.
+
+    Returns
+    -------
+    Carry
+        Zeroed arrays (metrics accumulators initialised).
+    """
+    acc = np.zeros((n, METRICS_SIZE))
+    for i in range(n):
+        metrics_init(acc[i])
+    return Carry(np.zeros((n, nxp)), np.zeros((n, nxc)), np.zeros((n, ncmd)), np.zeros((n, 3)), np.zeros((n, nxc)),
+                 acc, np.zeros((n, 3, 3)), np.zeros((n, SCRATCH_SIZE)), np.zeros((n, WORK_SIZE)),
+                 np.zeros((n, 2), np.int64), np.zeros((n, nobs)), np.zeros(n), np.zeros(n, np.int64),
+                 np.zeros((n, len(REWARD))))
+
+
+def env_step(ins, c, i, bound):
+    """One control period of env ``i``: write ``c.obs[i]``, ``c.reward[i]``, ``c.cause[i]``; return the cause.
+
+    The reward is minus the increments, over the period, of the metrics accumulator's sum of
+    squared error times dt (weight ``rw[0]``), sum of squared tau times dt (``rw[1]``) and
+    total variation of tau (``rw[2]``); a failure adds ``-rw[3]``.  ``ks[i]`` = (RK4 step, saturation
+    flags).  At the end of the run (step ``n_steps``) nothing is integrated and the cause is 0.
+    """
+    pp, cp, vp, path = ins.pp[i], ins.cp[i], ins.vp[i], ins.path[i]
+    si, sf, noise = ins.si[i], ins.sf[i], ins.noise[i]
+    xp, xc, cmd, tau1, kc1, acc = c.xp[i], c.xc[i], c.cmd[i], c.tau1[i], c.kc1[i], c.acc[i]
+    rw = c.rw[i]
+    n_steps, ctrl_every = si[SI.n_steps], si[SI.ctrl_every]
+    dt = sf[SF.dt]
+    nxp, nxc = xp.shape[0], xc.shape[0]
+    xpn, xcn, xps, xcs = np.empty(nxp), np.empty(nxc), np.empty(nxp), np.empty(nxc)
+    kp1, kp2, kp3, kp4 = np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp)
+    kc2, kc3, kc4 = np.zeros(nxc), np.zeros(nxc), np.zeros(nxc)
+    cmd_sample = np.zeros(cmd.shape[0])
+    buf = Buffers(c.refm[i], c.work[i], c.scr[i], cmd)
+    refm = buf.refm
+    lp = Loop(pp, cp, vp, path, ins.rows[i], ins.current[i], ctrl_every, ctrl_every * dt)
+    tau = np.zeros(3)
+    aux1, aux = np.zeros(1), np.zeros(1)
+    reuse = state_free_disturbance(ins.rows[i])
+    t_late = 0.5 * (sf[SF.win_t0] + min(sf[SF.win_t1], n_steps * dt))
+    before = 0.0
+    for j in range(3):
+        before += rw[0] * acc[OFF_E2 + j] + rw[1] * acc[OFF_TEN + j] + rw[2] * acc[OFF_TV + j]
+    k, sat = c.ks[i, 0], c.ks[i, 1]
+    cause = CAUSE_NONE
+    for _ in range(ctrl_every):
+        if k >= n_steps:
+            break
+        t = k * dt
+        if k % ctrl_every == 0:
+            eval_reference(path, t, refm)
+            eta_t, nu_t = plant.pose(xp)
+            eta, nu = measure(eta_t, nu_t, noise, k // ctrl_every)
+            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf,
+                                    LawOutputs(tau1, kc1, aux1))
+            if status == 0 and not finite3(tau1):
+                status = STATUS_NONFINITE_INPUT
+            if status != 0:
+                cause = CAUSE_CONTROLLER
+                break
+            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt, cmd_sample)
+            for m in range(cmd_sample.shape[0]):
+                cmd[m] = cmd_sample[m]
+            for m in range(nxc):
+                kc2[m] = kc3[m] = kc4[m] = kc1[m]
+        att = plant_attitude(xp)
+        status, flags = stage(t, xp, xc, att, lp, buf, kp1, LawOutputs(tau1, kc1, aux1), True)
+        applied = plant.applied(xp, cmd, pp)
+        eta, nu = plant.pose(xp)
+        p1 = virtual_point(eta, att, vp[VP.ell])
+        e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
+        metrics_update(acc, t, dt, e, applied, sf[SF.win_t0], sf[SF.win_t1])
+        saturation_update(acc, t, dt, sat, sf[SF.win_t0], sf[SF.win_t1])
+        path_update(acc, t, dt, (eta[0], eta[1], eta[2]), path, sf[SF.win_t0], sf[SF.win_t1], t_late)
+        effort_update(acc, t, dt, plant.effort(xp, cmd, pp), sf[SF.win_t0], sf[SF.win_t1])
+        for m in range(nxp):
+            xps[m] = xp[m] + 0.5 * dt * kp1[m]
+        for m in range(nxc):
+            xcs[m] = xc[m] + 0.5 * dt * kc1[m]
+        stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, LawOutputs(tau, kc2, aux), True)
+        for m in range(nxp):
+            xps[m] = xp[m] + 0.5 * dt * kp2[m]
+        for m in range(nxc):
+            xcs[m] = xc[m] + 0.5 * dt * kc2[m]
+        stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, LawOutputs(tau, kc3, aux), not reuse)
+        for m in range(nxp):
+            xps[m] = xp[m] + dt * kp3[m]
+        for m in range(nxc):
+            xcs[m] = xc[m] + dt * kc3[m]
+        stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, LawOutputs(tau, kc4, aux), True)
+        for m in range(nxp):
+            xpn[m] = xp[m] + dt / 6.0 * (kp1[m] + 2.0 * kp2[m] + 2.0 * kp3[m] + kp4[m])
+        for m in range(nxc):
+            xcn[m] = xc[m] + dt / 6.0 * (kc1[m] + 2.0 * kc2[m] + 2.0 * kc3[m] + kc4[m])
+        cause = state_cause(xpn, xcn, sf)
+        if cause != CAUSE_NONE:
+            break
+        for m in range(nxp):
+            xp[m] = xpn[m]
+        for m in range(nxc):
+            xc[m] = xcn[m]
+        k += 1
+    c.ks[i, 0], c.ks[i, 1] = k, sat
+    after = 0.0
+    for j in range(3):
+        after += rw[0] * acc[OFF_E2 + j] + rw[1] * acc[OFF_TEN + j] + rw[2] * acc[OFF_TV + j]
+    c.reward[i] = before - after - (rw[3] if cause != CAUSE_NONE else 0.0)
+    c.cause[i] = cause
+    env_observe(ins, c, i, bound)
+    return cause
+
+
+def env_observe(ins, c, i, bound):
+    """The observation of env ``i`` at its current step (the measurement the law sees at that sample)."""
+    xp, cp, path, noise = c.xp[i], ins.cp[i], ins.path[i], ins.noise[i]
+    ctrl_every = ins.si[i][SI.ctrl_every]
+    k = c.ks[i, 0]
+    eta_t, nu_t = plant.pose(xp)
+    row = k // ctrl_every
+    if noise.shape[0] > 0 and row >= noise.shape[0]:
+        row = noise.shape[0] - 1
+    eta, nu = measure(eta_t, nu_t, noise, row)
+    _, _, ap = plant.feedback(xp, c.cmd[i], ins.pp[i])
+    observe(k * ins.sf[i][SF.dt], eta, nu, attitude(eta[3], eta[4]), path, ap, cp, bound, c.obs[i])
+
+
+def step_all(ins, c, bound):
+    """:func:`env_step` of every env (row) that has not ended, in a ``prange`` loop."""
+    for i in prange(c.xp.shape[0]):
+        if c.cause[i] == 0:
+            env_step(ins, c, i, bound)
+
+
+def step_serial(ins, c, bound):
+    """:func:`step_all` in one thread (few envs: waking the thread pool costs more than the steps)."""
+    for i in range(c.xp.shape[0]):
+        if c.cause[i] == 0:
+            env_step(ins, c, i, bound)
+
+
+def observe_all(ins, c, bound):
+    """:func:`env_observe` of every env."""
+    for i in range(c.xp.shape[0]):
+        env_observe(ins, c, i, bound)
+
+
+PARTS = {"env_step": "njit(nogil=True)", "env_observe": "njit(nogil=True)",
+         "step_all": "njit(nogil=True, parallel=True)", "step_serial": "njit(nogil=True)", "observe_all": "njit(nogil=True)"}
+_LOCK = threading.Lock()
+
+
+def step_source(key: kernels.KernelKey) -> str:
+    """Source of the step module of a (replay law, plant) pair: the kernel module's names and a copy of :data:`PARTS`."""
+    parts = []
+    for name, deco in PARTS.items():
+        parts.append(f"@{deco}\n" + inspect.getsource(globals()[name]))
+    head = f'''"""Environment step of one (replay law, plant) pair: generated by auvtrack.gym.stepping; do not edit."""
+from numba import prange  # noqa: F401
+from auvtrack.engine.kernels import KernelKey, kernel_module
+from auvtrack.jit import njit  # noqa: F401
+from auvtrack.control.policy_observation import observe  # noqa: F401
+from auvtrack.metrics import OFF_E2, OFF_TEN, OFF_TV  # noqa: F401
+_k = kernel_module(KernelKey({key.law!r}, {key.plant!r}, {key.label!r}))
+globals().update({{n: getattr(_k, n) for n in dir(_k) if not n.startswith("__")}})
+'''
+    return head + "\n\n" + "\n\n".join(parts)
+
+
+def step_module(key: kernels.KernelKey):
+    """The generated step module of ``key`` (``step_all``, ``observe_all``), imported on first use.
+
+    Parameters
+    ----------
+    key : KernelKey
+        The (replay law, plant) pair.
+
+    Returns
+    -------
+    module
+        The module.
+    """
+    name = f"gym_{key.name}"
+    modname = f"auvtrack_kernels.{name}"
+    with _LOCK:
+        if modname in sys.modules:
+            return sys.modules[modname]
+        kernels.kernel_module(key)
+        path = kernels._folder() / f"{name}.py"
+        kernels._write_if_changed(path, step_source(key))
+        spec = importlib.util.spec_from_file_location(modname, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[modname] = module
+        try:
+            spec.loader.exec_module(module)
+        except BaseException:
+            del sys.modules[modname]
+            raise
+        return module

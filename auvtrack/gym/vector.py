@@ -1,0 +1,129 @@
+"""``TrackVectorEnv``: N episodes of one suite cell stepped by one compiled call (a ``prange`` over the envs from :data:`~auvtrack.gym.stepping.PARALLEL_FROM` envs, one thread below).
+
+Rows of the engine's :class:`~auvtrack.engine.loop.Stacked` inputs and of the
+:class:`~auvtrack.gym.stepping.Carry` are the envs; :meth:`step` writes the actions into the rows'
+replay tables and calls the step module's ``step_all`` once.  Autoreset follows Gymnasium's
+default (``NEXT_STEP``): the step after an env ended resets it (seed index drawn from the vector
+env's generator) and returns its first observation with reward 0.  A reset prepares that env's
+run in Python (once per episode); the step itself runs no per-env Python.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+
+from ..benchmark.suite import Suite
+from ..control.policy_observation import OBS_BOUND
+from ..engine.loop import SI
+from .env import TrackEnv
+from .replay import GAINS
+from .stepping import PARALLEL_FROM, new_carry
+
+
+class TrackVectorEnv(VectorEnv):
+    """``num_envs`` episodes of one cell (parameters as :class:`~auvtrack.gym.env.TrackEnv`).
+
+    Parameters
+    ----------
+    num_envs : int
+        Environments.
+    suite, task, tier, action, substeps, duration
+        As :class:`~auvtrack.gym.env.TrackEnv`.
+    """
+
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(self, num_envs: int, suite: str | Path | Suite = "auv-track-v1", task: str | None = None,
+                 tier: str | None = None, action: str = "tau", substeps: int = 10,
+                 duration: float | None = None) -> None:
+        self.num_envs = int(num_envs)
+        self.one = TrackEnv(suite, task, tier, action=action, substeps=substeps, duration=duration)
+        self.single_observation_space = self.one.observation_space
+        self.single_action_space = self.one.action_space
+        self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
+        self.ins = self.carry = None
+        self._done = np.zeros(self.num_envs, bool)
+        self.seed_indices = np.zeros(self.num_envs, np.int64)
+
+    def _load(self, i: int, index: int) -> None:
+        """Prepare env ``i`` for seed index ``index`` and copy its rows in."""
+        self.one.reset(seed=index)
+        one_ins, one_c = self.one.ins, self.one.carry
+        if self.ins is None:
+            self.ins = type(one_ins)(*[np.repeat(a, self.num_envs, axis=0) for a in one_ins])
+            self.carry = new_carry(self.num_envs, one_c.xp.shape[1], one_c.xc.shape[1], one_c.cmd.shape[1],
+                                   one_c.obs.shape[1])
+            self.kernels = self.one.kernels
+        for dst, src in zip(self.ins, one_ins):
+            dst[i] = src[0]
+        for dst, src in zip(self.carry, one_c):
+            dst[i] = src[0]
+        self.seed_indices[i] = index
+
+    def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
+        """Reset every env: seed indices ``seed + i`` (or the given list, or drawn).
+
+        Parameters
+        ----------
+        seed : int or list of int, optional
+            Seed index of env 0 (env i gets ``seed + i``), or one per env.
+        options : dict, optional
+            Unused.
+
+        Returns
+        -------
+        (numpy.ndarray, dict)
+            Observations (num_envs, OBS.size) and ``{"seed_index": array}``.
+        """
+        if isinstance(seed, (list, tuple)):
+            seeds = [int(s) for s in seed]
+        elif seed is not None:
+            seeds = [int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = None
+        self._np_random, _ = gym.utils.seeding.np_random(None if seed is None else seeds[0])
+        if seeds is None:
+            seeds = [int(s) for s in self._np_random.integers(0, 2**31 - 1, self.num_envs)]
+        for i, s in enumerate(seeds):
+            self._load(i, s)
+        self._done[:] = False
+        return self.carry.obs.copy(), {"seed_index": self.seed_indices.copy()}
+
+    def step(self, actions):
+        """Step every env one control period in one compiled call (autoreset of the envs that ended).
+
+        Parameters
+        ----------
+        actions : array_like
+            (num_envs, 3) normalised commands.
+
+        Returns
+        -------
+        tuple
+            Observations, rewards, terminated, truncated, info (``metrics`` of the envs that ended
+            is left to :class:`~auvtrack.gym.env.TrackEnv`; here ``seed_index``).
+        """
+        a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 3), -1.0, 1.0)
+        c, ins = self.carry, self.ins
+        ended = np.flatnonzero(self._done)
+        for i in ended:  # NEXT_STEP autoreset: these envs start a new episode now
+            self._load(int(i), int(self._np_random.integers(0, 2**31 - 1)))
+        ctrl_every = ins.si[:, SI.ctrl_every]
+        rows = np.minimum(c.ks[:, 0] // ctrl_every, ins.cp[:, GAINS.n].astype(np.int64) - 1)
+        cols = GAINS.table + 3 * rows[:, None] + np.arange(3)[None, :]
+        ins.cp[np.arange(self.num_envs)[:, None], cols] = a
+        live = ~self._done
+        c.cause[~live] = -1  # the reset envs are not stepped this call
+        step = self.kernels.step_all if self.num_envs >= PARALLEL_FROM else self.kernels.step_serial
+        step(ins, c, OBS_BOUND)
+        c.cause[~live] = 0
+        reward = np.where(live, c.reward, 0.0)
+        terminated = live & (c.cause != 0)
+        truncated = live & ~terminated & (c.ks[:, 0] >= ins.si[:, SI.n_steps])
+        self._done = terminated | truncated
+        return c.obs.copy(), reward, terminated, truncated, {"seed_index": self.seed_indices.copy()}

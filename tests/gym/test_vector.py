@@ -1,0 +1,31 @@
+"""The vector environment: each row equals the single environment, and NEXT_STEP autoreset."""
+from __future__ import annotations
+
+import numpy as np
+
+from auvtrack.gym.env import TrackEnv
+from auvtrack.gym.vector import TrackVectorEnv
+
+from .test_env import SUITE
+
+
+def test_rows_equal_single_env_and_autoreset():
+    n, dur = 3, 0.4  # 20 control steps of 10 x 2 ms
+    vec = TrackVectorEnv(n, SUITE, "line", "model", duration=dur)
+    obs, info = vec.reset(seed=10)
+    assert list(info["seed_index"]) == [10, 11, 12]
+    rng = np.random.default_rng(3)
+    acts = rng.uniform(-1, 1, (20, n, 3))
+    singles = [TrackEnv(SUITE, "line", "model", duration=dur) for _ in range(n)]
+    first = [s.reset(seed=10 + i)[0] for i, s in enumerate(singles)]
+    np.testing.assert_array_equal(obs, np.array(first))
+    for k in range(20):
+        obs, rew, term, trunc, _ = vec.step(acts[k])
+        for i, s in enumerate(singles):
+            o, r, te, tr, _ = s.step(acts[k, i])
+            np.testing.assert_array_equal(obs[i], o)
+            assert rew[i] == r and term[i] == te and trunc[i] == tr
+    assert trunc.all()
+    obs, rew, term, trunc, info = vec.step(acts[0])  # the autoreset step: new episodes, reward 0
+    assert np.all(rew == 0.0) and not term.any() and not trunc.any()
+    assert np.all(vec.carry.ks[:, 0] == 0)
