@@ -12,7 +12,8 @@ Layout :data:`OBS` (float64, every entry clipped to +-:data:`OBS_BOUND` of its g
 ``last_action``     3     what the actuators produce now over the action scale (the held action)
 ==================  ====  ==========================================================================
 
-The body frame is Rz(psi) Ry(theta) (roll is not measured, :class:`~auvtrack.control.contract.Measured`).
+The body frame is Rz(psi) Ry(theta) (roll is not measured, :class:`~auvtrack.control.contract.Measured`):
+vectors are turned by :func:`auvtrack.vehicle.kinematics.body_from_ned`.
 """
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ import numpy as np
 from ..jit import njit_noalloc
 from ..packing import packed_layout
 from ..reference.kernel import reference_point
+from ..vehicle.kinematics import body_from_ned
 
 OBS = packed_layout("PolicyObservation", error=3, velocity_error=3, nu=5, attitude=4, heading_error=2,
                     preview=9, last_action=3)
@@ -41,23 +43,12 @@ def obs_bounds() -> np.ndarray:
         Positive bounds, in :data:`OBS` order.
     """
     b = np.empty(OBS.size)
-    sizes = {"error": 3, "velocity_error": 3, "nu": 5, "attitude": 4, "heading_error": 2, "preview": 9,
-             "last_action": 3}
-    for name, n in sizes.items():
-        off = getattr(OBS, name)
-        b[off:off + n] = BOUNDS[name]
+    for name in OBS.names:
+        b[OBS.span(name)] = BOUNDS[name]
     return b
 
 
 OBS_BOUND = obs_bounds()
-
-
-@njit_noalloc(inline="always")
-def to_body(att, vx, vy, vz):
-    """An NED vector in the body frame Rz(psi) Ry(theta): R^T v (Fossen 2011, eq. 2.18 without roll)."""
-    ct, st, cp, sp = att
-    a = cp * vx + sp * vy
-    return ct * a - st * vz, -sp * vx + cp * vy, st * a + ct * vz
 
 
 @njit_noalloc(inline="always")
@@ -82,9 +73,9 @@ def observe(t, eta, nu, att, path, applied, scale, bound, obs):
         Written, shape (OBS.size,).
     """
     p, v, _ = reference_point(path, t)
-    ex, ey, ez = to_body(att, p[0] - eta[0], p[1] - eta[1], p[2] - eta[2])
+    ex, ey, ez = body_from_ned(att, (p[0] - eta[0], p[1] - eta[1], p[2] - eta[2]))
     obs[OBS.error], obs[OBS.error + 1], obs[OBS.error + 2] = ex, ey, ez
-    bx, by, bz = to_body(att, v[0], v[1], v[2])
+    bx, by, bz = body_from_ned(att, (v[0], v[1], v[2]))
     obs[OBS.velocity_error], obs[OBS.velocity_error + 1], obs[OBS.velocity_error + 2] = bx - nu[0], by - nu[1], bz - nu[2]
     for i in range(5):
         obs[OBS.nu + i] = nu[i]
@@ -98,7 +89,7 @@ def observe(t, eta, nu, att, path, applied, scale, bound, obs):
     obs[OBS.heading_error], obs[OBS.heading_error + 1] = s, c
     for j in range(3):
         q, _, _ = reference_point(path, t + PREVIEW[j])
-        qx, qy, qz = to_body(att, q[0] - eta[0], q[1] - eta[1], q[2] - eta[2])
+        qx, qy, qz = body_from_ned(att, (q[0] - eta[0], q[1] - eta[1], q[2] - eta[2]))
         obs[OBS.preview + 3 * j], obs[OBS.preview + 3 * j + 1], obs[OBS.preview + 3 * j + 2] = qx, qy, qz
     for i in range(3):
         obs[OBS.last_action + i] = applied[i] / scale[i]

@@ -183,13 +183,30 @@ def lanes_module(key: KernelKey):
         The module; raises :class:`auvtrack.engine.lanes.NotLaneable` when the pair's law or
         plant uses a construct the lane rewrite does not handle.
     """
-    name = key.name + "__lanes"
+    return generated_module(key.name + "__lanes", lambda: lanes_source(key))
+
+
+def generated_module(name: str, source: Callable[[], str]):
+    """Write a generated module into the kernel cache folder (unless it holds it) and import it once.
+
+    Parameters
+    ----------
+    name : str
+        Module name inside the cache folder (``auvtrack_kernels.<name>``).
+    source : callable
+        Returns the module's source; called only when the module is not imported yet.
+
+    Returns
+    -------
+    module
+        The imported module (removed from ``sys.modules`` again if its import fails).
+    """
     modname = f"auvtrack_kernels.{name}"
     with _LOCK:
         if modname in sys.modules:
             return sys.modules[modname]
         path = _folder() / f"{name}.py"
-        _write_if_changed(path, lanes_source(key))
+        _write_if_changed(path, source())
         spec = importlib.util.spec_from_file_location(modname, path)
         module = importlib.util.module_from_spec(spec)
         sys.modules[modname] = module

@@ -3,24 +3,26 @@
 :func:`env_step` is the body of the engine's loop (:func:`auvtrack.engine.loop.run`, sampled-data
 mode) cut at control samples: the same stage, metrics and stop checks in the same order, so that an
 episode driven by the replay law (:mod:`auvtrack.gym.replay`) integrates the numbers of an engine
-run of the same actions.  Like the engine's parts it is plain Python here; :func:`step_module`
+run of the same actions.  Like the engine's parts it is valid Python here (its names are the engine loop's); :func:`step_module`
 writes, per plant, a module that imports the (replay, plant) kernel module and compiles a copy.
 Inputs are the engine's :class:`~auvtrack.engine.loop.Stacked` (row i = env i); the per-env state
 is a :class:`Carry`.
 """
 from __future__ import annotations
 
-import importlib.util
 import inspect
-import sys
-import threading
 from typing import NamedTuple
 
 import numpy as np
 
 from ..control.contract import WORK_SIZE
 from ..engine import kernels
-from ..engine.loop import INFO_SIZE  # noqa: F401
+from ..control.policy_observation import observe
+from ..engine.loop import (  # the engine's parts this step is built of (rebound in the generated module)
+    CAUSE_CONTROLLER, CAUSE_NONE, SF, SI, STATUS_NONFINITE_INPUT, VP, Buffers, LawOutputs, Loop, attitude,
+    control_sample, effort_update, eval_reference, finite3, measure, metrics_update, path_update, plant,
+    plant_attitude, prange, saturation_update, stage, state_cause, state_free_disturbance, virtual_point,
+)
 from ..metrics import METRICS_SIZE, OFF_E2, OFF_TEN, OFF_TV, metrics_init
 from ..plant.contract import SCRATCH_SIZE
 
@@ -210,7 +212,6 @@ def observe_all(ins, c, bound):
 
 PARTS = {"env_step": "njit(nogil=True)", "env_observe": "njit(nogil=True)",
          "step_all": "njit(nogil=True, parallel=True)", "step_serial": "njit(nogil=True)", "observe_all": "njit(nogil=True)"}
-_LOCK = threading.Lock()
 
 
 def step_source(key: kernels.KernelKey) -> str:
@@ -243,20 +244,5 @@ def step_module(key: kernels.KernelKey):
     module
         The module.
     """
-    name = f"gym_{key.name}"
-    modname = f"auvtrack_kernels.{name}"
-    with _LOCK:
-        if modname in sys.modules:
-            return sys.modules[modname]
-        kernels.kernel_module(key)
-        path = kernels._folder() / f"{name}.py"
-        kernels._write_if_changed(path, step_source(key))
-        spec = importlib.util.spec_from_file_location(modname, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[modname] = module
-        try:
-            spec.loader.exec_module(module)
-        except BaseException:
-            del sys.modules[modname]
-            raise
-        return module
+    kernels.kernel_module(key)
+    return kernels.generated_module(f"gym_{key.name}", lambda: step_source(key))
