@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from .jit import njit, njit_noalloc
-from .reference.path import SPEED2_MIN, along_track_error, path_errors, project
+from .reference.path import SPEED2_MIN, along_track_error, path_errors, project, project_from
 
 AXES = ("x", "y", "z")
 INPUTS = ("u", "q", "r")
@@ -43,7 +43,8 @@ PATH_DUR, PATH_XT2, PATH_XTMAX, PATH_VT2, PATH_AL2 = 0, 1, 2, 3, 4
 OFF_ACT_DUR = 60
 OFF_ACT2, OFF_ACT_MAX, OFF_ACT_TV, OFF_ACT_PREV, OFF_ACT_LIMIT = 61, 64, 67, 70, 73
 OFF_ACT_GRID_K, OFF_ACT_HAVE_PREV = 76, 77
-METRICS_SIZE = 78
+OFF_PATH_PT = 78  # 9 values: the path point at OFF_PATH_S (position, velocity, acceleration), the next warm start
+METRICS_SIZE = 87
 PATH_WINDOW = 10.0  # s of path time: half-width of the projection's search window per step
 LIMIT_TOL = 1e-9  # an actuator is at its limit when its fraction of the limit is >= 1 - LIMIT_TOL
 
@@ -201,7 +202,8 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
 
     The projection (:func:`auvtrack.reference.path.project`) runs at every step, inside the window
     or not, from the previous step's path parameter (the time ``t`` at the first step), within
-    :data:`PATH_WINDOW` of it; the cross-track, vertical-track and along-track errors are then
+    :data:`PATH_WINDOW` of it, starting from the path point the previous step found there (kept in
+    the accumulator: the same numbers as evaluating it again, one evaluation fewer); the cross-track, vertical-track and along-track errors are then
     accumulated over the window ``[t0, t1)`` and over its second half ``t >= t_late``.
 
     Parameters
@@ -221,9 +223,15 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
     """
     guess = acc[OFF_PATH_S]
     if math.isnan(guess):
-        guess = t
-    s, pt = project(path, guess, p, PATH_WINDOW)
+        s, pt = project(path, t, p, PATH_WINDOW)
+    else:
+        o = OFF_PATH_PT
+        s, pt = project_from(path, guess, ((acc[o], acc[o + 1], acc[o + 2]), (acc[o + 3], acc[o + 4], acc[o + 5]),
+                                           (acc[o + 6], acc[o + 7], acc[o + 8])), p, PATH_WINDOW)
     acc[OFF_PATH_S] = s
+    for i in range(3):
+        for j in range(3):
+            acc[OFF_PATH_PT + 3 * i + j] = pt[i][j]
     tol = TOL_FRACTION * dt
     if t < t0 - tol or t >= t1 - tol:
         return

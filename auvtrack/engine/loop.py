@@ -57,9 +57,10 @@ from ..channels import LOG_ROW
 from ..jit import njit, njit_noalloc
 from ..jit.lane_values import as_lanes, first_lanes, get_lane
 
-SI = packed_layout("IntSettings", n_steps=1, log_every=1, ctrl_every=1, n_aux=1)
+SI = packed_layout("IntSettings", n_steps=1, log_every=1, ctrl_every=1, n_aux=1, path_metrics=1)
 """Engine integer settings: RK4 steps, steps per logged row, steps per control sample (0:
-continuous), the controller's channel count."""
+continuous), the controller's channel count, whether the path-following metrics are computed (1)
+or skipped (0: ``metrics.path = false``)."""
 INFO_STOP, INFO_STEPS, INFO_STATUS = 0, 1, 2
 INFO_SIZE = 3
 STOP_POLL = 1024  # steps between two reads of the stop flag (a power of two)
@@ -425,7 +426,8 @@ def run(pb, cb, env, ref_p, settings, out):
             break
         metrics_update(acc, t, dt, e, applied, sf[SF.win_t0], sf[SF.win_t1])
         saturation_update(acc, t, dt, sat, sf[SF.win_t0], sf[SF.win_t1])
-        path_update(acc, t, dt, (eta[0], eta[1], eta[2]), ref_p, sf[SF.win_t0], sf[SF.win_t1], t_late)
+        if si[SI.path_metrics] != 0:
+            path_update(acc, t, dt, (eta[0], eta[1], eta[2]), ref_p, sf[SF.win_t0], sf[SF.win_t1], t_late)
         effort_update(acc, t, dt, plant.effort(xp, cmd, pp), sf[SF.win_t0], sf[SF.win_t1])
         for i in range(nxp):
             xps[i] = xp[i] + 0.5 * dt * kp1[i]

@@ -20,7 +20,8 @@ Newton steps on g(s) = 0:
   downhill;
 * every step is clipped to the window [s_guess - window, s_guess + window], and halved (at most
   :data:`MAX_HALVINGS` times) until D strictly decreases at a point where the path moves
-  (|eta_d'|^2 > :data:`SPEED2_MIN`); a step that cannot do so ends the search; a step cut short
+  (|eta_d'|^2 > :data:`SPEED2_MIN`); a step that cannot do so ends the search (at once when the
+  step falls below half an ulp of s, where every further trial is s itself); a step cut short
   by a standing part of the path is then lengthened by bisection towards that part's edge (at
   most MAX_HALVINGS times), where the moving path is closest;
 * the search stops when a step is below :data:`S_TOL` (s), or at once when the path stands still
@@ -113,10 +114,39 @@ def project(path, s_guess, p, window):
         s (s of path time) and the path point there: (position (m), velocity (m/s), acceleration
         (m/s^2)), 3-tuples, as :func:`~auvtrack.reference.kernel.reference_point` gives them.
     """
+    return project_from(path, s_guess, reference_point(path, s_guess), p, window)
+
+
+@njit_noalloc
+def project_from(path, s_guess, pt_guess, p, window):
+    """:func:`project` given the path point at ``s_guess``, e.g. the one the previous projection returned.
+
+    A search warm-started from its previous answer would evaluate the path there again; passing
+    that point saves the evaluation and gives the same bits (the evaluation is a function of
+    ``s_guess`` alone).
+
+    Parameters
+    ----------
+    path : numpy.ndarray
+        Packed reference (:mod:`auvtrack.reference.kernel`).
+    s_guess : float
+        Start of the search (s of path time).
+    pt_guess : tuple
+        ``reference_point(path, s_guess)``: (position, velocity, acceleration), 3-tuples.
+    p : tuple of 3 float
+        Position (m, NED).
+    window : float
+        Half-width of the search window around ``s_guess`` (s of path time), > 0.
+
+    Returns
+    -------
+    (float, tuple)
+        As :func:`project`.
+    """
     lo = s_guess - window
     hi = s_guess + window
     s = s_guess
-    pt = reference_point(path, s)
+    pt = pt_guess
     dist2, d = _distance2(pt, p)
     for _ in range(MAX_ITER):
         v, a = pt[1], pt[2]
@@ -133,6 +163,8 @@ def project(path, s_guess, p, window):
         accepted = False
         standing = 0.0  # the shortest step tried that ended where the path stands still (0: none)
         for _h in range(MAX_HALVINGS):
+            if s + step == s:  # below half an ulp of s: every further trial is the point s itself, never accepted
+                break
             pt_new = reference_point(path, s + step)
             dist2_new, d_new = _distance2(pt_new, p)
             if not _speed2(pt_new) > SPEED2_MIN:
@@ -213,4 +245,4 @@ def along_track_error(pt, s, t):
     return (s - t) * math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
 
 
-__all__ = ["project", "path_errors", "along_track_error", "MAX_ITER", "MAX_HALVINGS", "NEWTON_MIN", "S_TOL", "SPEED2_MIN"]
+__all__ = ["project", "project_from", "path_errors", "along_track_error", "MAX_ITER", "MAX_HALVINGS", "NEWTON_MIN", "S_TOL", "SPEED2_MIN"]

@@ -370,9 +370,11 @@ def _window(value: Any) -> tuple[float, float]:
 
 
 class MetricsSection(_Section):
-    """``[metrics]``: time window [t0, t1] (s) over which the metrics are computed."""
+    """``[metrics]``: time window [t0, t1] (s) over which the metrics are computed; the path-following metrics on or off."""
 
     window: tuple[float, float] = Field((0.0, math.inf), description="s; t1 may be inf")
+    path: Bool = Field(True, description="compute the path-following metrics (a projection on the path at "
+                                         "every step); false: skip them (NaN), for speed")
 
     @field_validator("window", mode="before")
     @classmethod

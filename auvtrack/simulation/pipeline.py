@@ -171,7 +171,8 @@ def prepare(scenario: Scenario) -> Prepared:
     dt = sc.sim.dt
     n_steps, log_every, ctrl_every = plan.n_steps, plan.log_every, plan.control_every
     naux = len(cc.aux_names)
-    si = engine.SI.pack(np.int64, n_steps=n_steps, log_every=log_every, ctrl_every=ctrl_every, n_aux=naux)
+    si = engine.SI.pack(np.int64, n_steps=n_steps, log_every=log_every, ctrl_every=ctrl_every, n_aux=naux,
+                        path_metrics=int(sc.metrics.path))
     t0, t1 = sc.metrics.window
     phi_limit = getattr(sc.sim, "phi_limit", 90.0)
     sf = SF.pack(dt=dt, theta_lim=math.radians(sc.sim.theta_limit), state_lim=sc.sim.state_limit, win_t0=t0,
