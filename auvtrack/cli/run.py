@@ -41,7 +41,7 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
     except FolderError as exc:
         raise BadInput(f"{'--out' if out is not None else 'run folder'}: {one_line(exc)}") from None
     for note in prep.notes:
-        click.echo(f"warning: {note}", err=True)
+        click.echo(f"note: {note}", err=True)
     if spec_for(sc.controller).tracks:  # a reference the plant cannot fly: say so, fly anyway
         from ..feasibility import assess
 
@@ -95,7 +95,7 @@ def check(scenario: str, overrides: tuple[str, ...]) -> None:
     sc = load_arg(scenario, overrides)
     prep = prepare_arg(scenario, sc)
     for note in prep.notes:
-        click.echo(f"warning: {note}", err=True)
+        click.echo(f"note: {note}", err=True)
     spec = spec_for(sc.controller)
     for v in (spec.warnings(sc.controller) if spec.warnings else []):
         click.echo(f"warning: {v}", err=True)
