@@ -8,7 +8,7 @@ import click
 
 from .common import (EXIT_CODES_HELP, EXIT_INTERRUPTED, EXIT_SIM_FAILED, LONG_RUN_STEPS, BadInput, cli, load_arg, mib,
                      one_line, prepare_arg, set_option)
-from .digest import saturation_warning
+from .digest import manoeuvre_line, manoeuvre_metrics, saturation_warning
 from .signals import stop_requests
 
 
@@ -54,6 +54,9 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         res = run_prepared(prep)
     except SimulationInterrupted as exc:  # stopped within about a second; write what was computed
         res = exc.result
+    manoeuvre = None if spec_for(sc.controller).tracks else manoeuvre_metrics(res, sc.controller)
+    if manoeuvre is not None:  # an open-loop run: its manoeuvre, not a tracking error, is the result
+        res.meta["manoeuvre"] = manoeuvre
     try:  # Ctrl-C while the folder is written: keep the rows written so far, publish, exit 130
         with stop_requests() as requested:
             folder = res.save(target, mat=mat or sc.output.mat, overwrite=out is not None, stop=requested)
@@ -61,6 +64,8 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         click.echo(f"auvtrack: error: the run folder {target} could not be written: {one_line(exc)}", err=True)
         raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
+    if manoeuvre is not None:
+        click.echo(manoeuvre_line(manoeuvre))
     if res.ok and (line := saturation_warning(res.metrics, float(res.t[-1]))) is not None:
         click.echo(f"warning: {line}", err=True)
     if requested():
