@@ -189,7 +189,8 @@ def prepare(scenario: Scenario) -> Prepared:
         ref_p=_c(ref_p), settings=Settings(si, sf),
         n_rows=plan.log_rows,
         channels=channels,
-        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[VP.ell])] if n),
+        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[VP.ell])]
+                                                            if n and cspec.tracks),  # open loop: no tracking
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": {**cc.resolved, **design_record(sc)}},
         statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
