@@ -151,6 +151,32 @@ def quick_outputs(quick: bool = True):
         _QUICK.reset(token)
 
 
+def metric_unit(name: str) -> str:
+    """The unit of metric ``name`` (``rmse_x`` -> ``m``, ``max_abs_tau_q`` -> ``N*m``), from :data:`auvtrack.metrics.METRIC_UNITS`.
+
+    Parameters
+    ----------
+    name : str
+        A metric name (its family, then an axis or input suffix).
+
+    Returns
+    -------
+    str
+        The unit for that axis or input ("" for an unknown family).
+    """
+    from .metrics import METRIC_UNITS
+
+    suffix = name.rpartition("_")[2]
+    family = name if name in METRIC_UNITS else name.rpartition("_")[0]
+    while family and family not in METRIC_UNITS:
+        family = family.rpartition("_")[0]
+    unit = METRIC_UNITS.get(family, "")
+    if " (u) or " in unit:  # "N (u) or N*m (q, r)": the input's own
+        first, rest = unit.split(" (u) or ", 1)
+        unit = first if suffix == "u" else rest.split(" (", 1)[0]
+    return unit
+
+
 def write_json(path: str | Path, obj: Any) -> Path:
     """Write ``obj`` as strict JSON (non-finite floats become ``null``); return the path.
 
