@@ -245,7 +245,8 @@ def _forms_report(rep: Report, forms: list[dict]) -> None:
 def _table_rows(full: dict[str, dict], steady: dict[str, dict], window: tuple[float, float]) -> list[list[str]]:
     keys = ([f"settle_{s}_{a}" for s in ("5cm", "1cm", "1mm") for a in AXES]
             + [f"rmse_{a}" for a in AXES] + [f"max_abs_{a}" for a in AXES] + [f"itae_{a}" for a in AXES]
-            + [f"max_abs_tau_{j}" for j in INPUTS] + [f"energy_tau_{j}" for j in INPUTS] + [f"tv_tau_{j}" for j in INPUTS])
+            + [f"max_abs_tau_{j}" for j in INPUTS] + [f"energy_tau_{j}" for j in INPUTS] + [f"tv_tau_{j}" for j in INPUTS]
+            + [f"t_sat_tau_{j}" for j in INPUTS])  # time with the input's command saturated
     rows = [[k, metric_unit(k), "whole run", _fmt(full["FXTNTSMC"][k]), _fmt(full["FTSMC"][k])] for k in keys]
     for k in [f"rmse_{a}" for a in AXES] + [f"max_abs_{a}" for a in AXES] + [f"tv_tau_{j}" for j in INPUTS]:
         rows.append([k, metric_unit(k), f"[{window[0]:g}, {window[1]:g}] s", _fmt(steady["FXTNTSMC"][k]),
