@@ -25,12 +25,15 @@ from ..engine import loop as engine
 from ..plant.contract import SF, with_sizes
 from ..user_modules import first_line, load_module
 
-__all__ = ["PROBE_S", "PROBE_MAX_STEPS", "LawFault", "probe"]
+__all__ = ["PROBE_S", "PROBE_MAX_STEPS", "PROBE_WALL_S", "LawFault", "probe"]
 
 PROBE_S = 2.0
 """Simulated seconds of the probe run (fewer when the scenario is shorter)."""
 PROBE_MAX_STEPS = 50_000
 """At most this many RK4 steps (a very small time step probes less than :data:`PROBE_S`)."""
+PROBE_WALL_S = 60.0
+"""Wall-clock seconds the probe run may take: a law still computing then (an endless loop) is refused;
+a probe that stopped at the request (a slow law) ends without a verdict."""
 
 
 class LawFault(ValueError):
@@ -78,9 +81,14 @@ def probe(prep, *, notice=None) -> None:
     def stop() -> None:
         out.info[engine.INFO_STOP] = 1
 
-    outcome = run_in_thread(lambda: call_kernel(short, out), stop, reraise=False)
-    if outcome.interrupted or outcome.abandoned:
+    outcome = run_in_thread(lambda: call_kernel(short, out), stop, reraise=False, timeout=PROBE_WALL_S)
+    if outcome.interrupted:
         raise KeyboardInterrupt
+    if outcome.abandoned:  # timed out and the law never came back to the loop
+        raise LawFault(f"controller.module: {prep.key.law}: control did not return within {PROBE_WALL_S:g} s of "
+                       f"wall time in the bounds-checked probe run of the first {steps * dt:.6g} s (an endless loop?)")
+    if outcome.timed_out:
+        return  # a slow law: stopped at the request, nothing wrong seen
     if isinstance(outcome.value, BaseException) or outcome.value is None:
         return  # a plant that raised: the run reports it with its partial result
     cause, _, t = outcome.value

@@ -100,3 +100,37 @@ def test_the_checked_kernel_only_rebinds_the_law():
     assert extra == ["law = llvm_inline(load_module('auvtrack.control.pid').control)",
                      "from auvtrack.control.plugin import bounds_checked  # noqa: E402",
                      "law = bounds_checked(law)"]
+
+
+ENDLESS = HEAD + """    if t > args.cp[0]:
+        while True:
+            out.u[0] += 1.0
+    return 0
+"""
+DRIVER = """
+import sys
+import auvtrack.simulation.probe as probe
+from auvtrack.cli import main
+probe.PROBE_WALL_S = 3.0
+sys.exit(main([sys.argv[1], sys.argv[2]] + sys.argv[3:]))
+"""
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_a_law_that_never_returns_is_refused_after_the_probes_wall_time(tmp_path, command):
+    """An endless loop at t > 0.5 s: check and run refuse it in one line (exit 2, nothing written)
+    once the probe's wall-time bound has passed, and the process ends although the law still runs."""
+    import subprocess
+    import sys
+    import time
+
+    sc = _scenario(tmp_path, ENDLESS)
+    out = tmp_path / "out"
+    t0 = time.monotonic()
+    p = subprocess.run([sys.executable, "-c", DRIVER, command, str(sc)] + (["--out", str(out)] if command == "run"
+                                                                             else []),
+                       capture_output=True, text=True, timeout=600)
+    assert p.returncode == EXIT_BAD_INPUT, p.stderr
+    err = [ln for ln in p.stderr.splitlines() if not ln.startswith("compiling kernels")]
+    assert len(err) == 1 and "control did not return within 3 s of wall time" in err[0] and "law.py" in err[0]
+    assert not out.exists() and time.monotonic() - t0 < 300
