@@ -24,8 +24,9 @@ _ABANDONED: list[threading.Thread] = []
 class Outcome:
     """What :func:`run_in_thread` saw: the value (if any), and whether Ctrl-C came and the work was abandoned."""
 
-    def __init__(self, value: Any, interrupted: bool, abandoned: bool):
+    def __init__(self, value: Any, interrupted: bool, abandoned: bool, timed_out: bool = False):
         self.value, self.interrupted, self.abandoned = value, interrupted, abandoned
+        self.timed_out = timed_out
 
 
 def abandoned() -> bool:
@@ -34,7 +35,7 @@ def abandoned() -> bool:
 
 
 def run_in_thread(fn: Callable[[], Any], on_interrupt: Callable[[], None] | None = None, *,
-                  grace: float = GRACE_S, reraise: bool = True) -> Outcome:
+                  grace: float = GRACE_S, reraise: bool = True, timeout: float | None = None) -> Outcome:
     """Run ``fn()`` in a daemon thread; Ctrl-C in the waiting (main) thread calls ``on_interrupt``.
 
     Parameters
@@ -48,6 +49,9 @@ def run_in_thread(fn: Callable[[], Any], on_interrupt: Callable[[], None] | None
         Seconds to wait after Ctrl-C before the thread is abandoned.
     reraise : bool, optional
         Re-raise an exception ``fn`` raised (else it is the outcome's value).
+    timeout : float, optional
+        Seconds after which the work is stopped as on Ctrl-C (``on_interrupt``, then abandoned
+        after ``grace``), the outcome marked ``timed_out`` instead of ``interrupted``.
 
     Returns
     -------
@@ -74,21 +78,27 @@ def run_in_thread(fn: Callable[[], Any], on_interrupt: Callable[[], None] | None
 
     th = threading.Thread(target=target, name="auvtrack-work", daemon=True)
     th.start()
-    interrupted, deadline = False, None
+    interrupted, timed_out, deadline = False, False, None
+    give_up = None if timeout is None else time.monotonic() + timeout
     while not done.is_set():
         try:
             done.wait(0.05)
         except KeyboardInterrupt:
             if not interrupted:
                 interrupted = True
-                if on_interrupt is not None:
+                if on_interrupt is not None and not timed_out:
                     on_interrupt()
                 deadline = time.monotonic() + (grace if on_interrupt is not None else 0.0)
+        if give_up is not None and not (interrupted or timed_out) and time.monotonic() >= give_up:
+            timed_out = True
+            if on_interrupt is not None:
+                on_interrupt()
+            deadline = time.monotonic() + (grace if on_interrupt is not None else 0.0)
         if deadline is not None and time.monotonic() >= deadline and not done.is_set():
             _ABANDONED.append(th)
-            return Outcome(None, True, True)
+            return Outcome(None, interrupted, True, timed_out)
     if "error" in box:
         if reraise:
             raise box["error"]
-        return Outcome(box["error"], interrupted, False)
-    return Outcome(box.get("value"), interrupted, False)
+        return Outcome(box["error"], interrupted, False, timed_out)
+    return Outcome(box.get("value"), interrupted, False, timed_out)

@@ -21,6 +21,8 @@ PosixPath('studies/demo/report.md')                          # and studies/demo/
 from __future__ import annotations
 
 import base64
+import contextlib
+import contextvars
 import json
 import math
 import re
@@ -124,12 +126,66 @@ def metrics_table(metrics: Mapping[str, Mapping[str, Any]], keys: Sequence[str],
     return markdown_table([label, *keys], rows, digits)
 
 
+_QUICK: contextvars.ContextVar[bool] = contextvars.ContextVar("auvtrack_quick_outputs", default=False)
+QUICK_BANNER = ("**Quick run** (`--quick`, CI-sized): short horizons and few cases; the numbers are a smoke test, "
+                "not the study's result.")
+
+
+@contextlib.contextmanager
+def quick_outputs(quick: bool = True):
+    """Mark what a ``--quick`` run writes inside the block: a banner opening each report, ``"quick": true`` in results.
+
+    Parameters
+    ----------
+    quick : bool, optional
+        Whether the run is a quick one (False: nothing is marked).
+
+    Yields
+    ------
+    None
+    """
+    token = _QUICK.set(bool(quick))
+    try:
+        yield
+    finally:
+        _QUICK.reset(token)
+
+
+def metric_unit(name: str) -> str:
+    """The unit of metric ``name`` (``rmse_x`` -> ``m``, ``max_abs_tau_q`` -> ``N*m``), from :data:`auvtrack.metrics.METRIC_UNITS`.
+
+    Parameters
+    ----------
+    name : str
+        A metric name (its family, then an axis or input suffix).
+
+    Returns
+    -------
+    str
+        The unit for that axis or input ("" for an unknown family).
+    """
+    from .metrics import METRIC_UNITS
+
+    suffix = name.rpartition("_")[2]
+    family = name if name in METRIC_UNITS else name.rpartition("_")[0]
+    while family and family not in METRIC_UNITS:
+        family = family.rpartition("_")[0]
+    unit = METRIC_UNITS.get(family, "")
+    if " (u) or " in unit:  # "N (u) or N*m (q, r)": the input's own
+        first, rest = unit.split(" (u) or ", 1)
+        unit = first if suffix == "u" else rest.split(" (", 1)[0]
+    return unit
+
+
 def write_json(path: str | Path, obj: Any) -> Path:
     """Write ``obj`` as strict JSON (non-finite floats become ``null``); return the path.
 
     NumPy arrays and scalars, tuples and paths are converted as well
-    (:func:`auvtrack.simulation.result.to_jsonable`).
+    (:func:`auvtrack.simulation.result.to_jsonable`).  Inside :func:`quick_outputs` a dict
+    document gets ``"quick": true`` first.
     """
+    if _QUICK.get() and isinstance(obj, Mapping):
+        obj = {"quick": True, **{k: v for k, v in obj.items() if k != "quick"}}
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(to_jsonable(obj), indent=2, allow_nan=False) + "\n", encoding="utf-8")
@@ -304,6 +360,8 @@ class Report:
         self.out = Path(out)
         self.title = title
         self.blocks: list[Block] = []
+        if _QUICK.get():
+            self.paragraph(QUICK_BANNER)
         self.scenarios: list[tuple[str, str]] = []
         self.figures: list[Path] = []
 

@@ -307,17 +307,19 @@ def _base_scenario(study: StudyFile, folder: Path, source: str) -> dict:
 
 
 def _problem(spec: SweepSpec, overrides: dict) -> ValueError | None:
-    """Validate one sample as ``auvtrack check`` would (load, plan, controller set-up); the error or None."""
+    """Validate one sample as ``auvtrack check`` would (load, plan, controller set-up, a plug-in's probe run);
+    the error or None."""
     import warnings
 
     from ..scenario import load_scenario
     from ..simulation.pipeline import prepare
+    from ..simulation.probe import probe
 
     try:
         sc = load_scenario(spec.base, overrides)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            prepare(sc)
+            probe(prepare(sc))
     except ValueError as exc:  # ScenarioError of the schema or the run plan, a controller refusing its set-up
         return exc
     return None

@@ -37,11 +37,14 @@ def load_arg(scenario: str, overrides: tuple[str, ...]):
 
 
 def prepare_arg(scenario: str, sc):
-    """The run's validation after loading: plan and controller set-up (``check`` = ``run`` minus the run)."""
+    """The run's validation after loading: plan, set-up, a plug-in law's probe (``check`` = ``run`` minus the run)."""
     from ..simulation.pipeline import prepare
+    from ..simulation.probe import probe
 
     try:
-        return prepare(sc)
+        prep = prepare(sc)
+        probe(prep)
+        return prep
     except ValueError as exc:  # ScenarioError of the plan, or a controller refusing its set-up
         import traceback
 

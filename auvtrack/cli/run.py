@@ -8,8 +8,15 @@ import click
 
 from .common import (EXIT_CODES_HELP, EXIT_INTERRUPTED, EXIT_SIM_FAILED, LONG_RUN_STEPS, BadInput, cli, load_arg, mib,
                      one_line, prepare_arg, set_option)
-from .digest import saturation_warning
+from .digest import manoeuvre_line, manoeuvre_metrics, saturation_warning
 from .signals import stop_requests
+
+
+def _note_kind(note: str) -> str:
+    """``warning`` for a start off the reference (a run may fail on it), ``note`` for other set-up notes."""
+    from ..reference.start import NOTE_PREFIX
+
+    return "warning" if note.startswith(NOTE_PREFIX) else "note"
 
 
 @cli.command(epilog=EXIT_CODES_HELP)
@@ -41,7 +48,7 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
     except FolderError as exc:
         raise BadInput(f"{'--out' if out is not None else 'run folder'}: {one_line(exc)}") from None
     for note in prep.notes:
-        click.echo(f"warning: {note}", err=True)
+        click.echo(f"{_note_kind(note)}: {note}", err=True)
     if spec_for(sc.controller).tracks:  # a reference the plant cannot fly: say so, fly anyway
         from ..feasibility import assess
 
@@ -54,6 +61,10 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         res = run_prepared(prep)
     except SimulationInterrupted as exc:  # stopped within about a second; write what was computed
         res = exc.result
+    tracks = spec_for(sc.controller).tracks
+    manoeuvre = None if tracks else manoeuvre_metrics(res, sc.controller)
+    if manoeuvre is not None:  # an open-loop run: its manoeuvre, not a tracking error, is the result
+        res.meta["manoeuvre"] = manoeuvre
     try:  # Ctrl-C while the folder is written: keep the rows written so far, publish, exit 130
         with stop_requests() as requested:
             folder = res.save(target, mat=mat or sc.output.mat, overwrite=out is not None, stop=requested)
@@ -61,7 +72,9 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
         click.echo(f"auvtrack: error: the run folder {target} could not be written: {one_line(exc)}", err=True)
         raise click.exceptions.Exit(EXIT_SIM_FAILED) from None
     click.echo(f"{res!r}\nwritten: {folder}")
-    if res.ok and (line := saturation_warning(res.metrics, float(res.t[-1]))) is not None:
+    if manoeuvre is not None:
+        click.echo(manoeuvre_line(manoeuvre))
+    if res.ok and tracks and (line := saturation_warning(res.metrics, float(res.t[-1]))) is not None:
         click.echo(f"warning: {line}", err=True)
     if requested():
         kept = json.loads((folder / "run.json").read_text(encoding="utf-8"))["files"]["trajectory.csv"]
@@ -95,7 +108,7 @@ def check(scenario: str, overrides: tuple[str, ...]) -> None:
     sc = load_arg(scenario, overrides)
     prep = prepare_arg(scenario, sc)
     for note in prep.notes:
-        click.echo(f"warning: {note}", err=True)
+        click.echo(f"{_note_kind(note)}: {note}", err=True)
     spec = spec_for(sc.controller)
     for v in (spec.warnings(sc.controller) if spec.warnings else []):
         click.echo(f"warning: {v}", err=True)

@@ -20,9 +20,11 @@ def reproduce(out: str, quick: bool) -> None:
     Writes the run folders, figures/, metrics.json, summary.md and report.html (one
     self-contained page with every figure) to --out.
     """
+    from ..report import quick_outputs
     from ..studies.reproduce import reproduce as _reproduce
 
-    _reproduce(Path(out), quick=quick, progress=True)
+    with quick_outputs(quick):
+        _reproduce(Path(out), quick=quick, progress=True)
     metrics = json.loads((Path(out) / "metrics.json").read_text(encoding="utf-8"))
     click.echo("\n".join(reproduce_lines(metrics)))
     click.echo(f"written: {Path(out) / 'summary.md'}, {Path(out) / 'report.html'}")
@@ -49,7 +51,7 @@ class _StudyCommand(click.Command):
               help="ablation: pulse onset in s (default 20; the run lasts until T + 20 s).")
 def study(name: str, out: str | None, quick: bool, pulse: str | None, pulse_start: float | None) -> None:
     """Run study NAME and write report.md, report.html, results.json and figures/ (NAME 'list': list them)."""
-    from ..studies.registry import all_studies, get_study
+    from ..studies.registry import all_studies, get_study, run_study
 
     if name == "list":
         for n, spec in sorted(all_studies().items()):
@@ -63,6 +65,6 @@ def study(name: str, out: str | None, quick: bool, pulse: str | None, pulse_star
     for k in options:
         if k not in spec.options:
             raise BadInput(f"--{k.replace('_', '-')}: not an option of study {name!r}")
-    report = spec.run(Path(out) if out else Path("studies") / name, quick=quick, progress=True, **options)
+    report = run_study(spec, Path(out) if out else Path("studies") / name, quick=quick, progress=True, **options)
     html = report.with_suffix(".html")
     click.echo(f"report: {report}" + (f", {html}" if html.exists() else ""))

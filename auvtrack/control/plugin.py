@@ -54,7 +54,11 @@ class PluginFailure(ValueError):
         self.cause = cause
 
 
-__all__ = ["PluginFailure", "Params", "setup", "load", "spec_of", "CompiledController", "ControllerParamsBase", "ControllerParams",
+STATUS_RAISED = 9
+"""Status of a law that raised (an index out of bounds under bounds checking) in a probe run
+(:func:`bounds_checked`); a code of the shared range 1-9 that no law returns."""
+
+__all__ = ["PluginFailure", "STATUS_RAISED", "bounds_checked", "Params", "setup", "load", "spec_of", "CompiledController", "ControllerParamsBase", "ControllerParams",
            "SetupContext", "njit", "njit_noalloc", "packed_layout", "tunable", "error_state", "error_state_forces",
            "input_for_accel", "input_for_accel_forces", "sig", "sign", "WORK_SIZE", "CONTROLLER_STATUS"]
 
@@ -198,6 +202,54 @@ def _probe(mod, law: str, cc: CompiledController, ctx: SetupContext) -> None:
     if isinstance(status, (bool, np.bool_)) or not isinstance(status, (int, np.integer)):
         raise ValueError(f"controller.module: {law}: control must return an int status "
                          f"(got {type(status).__name__} {status!r})")
+
+
+_CHECKED: dict = {}
+
+
+def bounds_checked(law):
+    """The law compiled with bounds checking, any exception it raises returned as :data:`STATUS_RAISED`.
+
+    A law that writes past an array's end corrupts memory silently in the compiled loop (and may
+    crash the process at exit); compiled with ``boundscheck=True`` the same write raises
+    ``IndexError``, which the wrapper catches so that the loop stops with a controller status,
+    recording the time and the state (the kernel of a probe run,
+    ``KernelKey(..., checked=True)``).  Only the law's own body is checked, not the compiled
+    helpers it calls.
+
+    Parameters
+    ----------
+    law : numba dispatcher
+        A controller module's compiled ``control``.
+
+    Returns
+    -------
+    numba dispatcher
+        ``guarded(t, y, xc, args, out) -> int``, made once per law and process.
+    """
+    import types as pytypes
+
+    import numba
+
+    got = _CHECKED.get(law)
+    if got is not None:
+        return got
+    fn = law.py_func
+    copy = pytypes.FunctionType(fn.__code__, fn.__globals__, fn.__name__, fn.__defaults__, fn.__closure__)
+    copy.__qualname__ = fn.__qualname__ + "__bounds_checked"
+    copy.__module__ = fn.__module__
+    checked = numba.njit(boundscheck=True, error_model="numpy")(copy)
+    raised = STATUS_RAISED
+
+    @numba.njit(boundscheck=True, error_model="numpy")
+    def guarded(t, y, xc, args, out):
+        try:
+            return checked(t, y, xc, args, out)
+        except Exception:  # noqa: BLE001 - any exception of the law becomes a status the probe reports
+            return raised
+
+    _CHECKED[law] = guarded
+    return guarded
 
 
 def setup(params: Params, ctx: SetupContext) -> CompiledController:

@@ -190,7 +190,8 @@ def prepare(scenario: Scenario) -> Prepared:
         ref_p=_c(ref_p), settings=Settings(si, sf),
         n_rows=plan.log_rows,
         channels=channels,
-        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[VP.ell])] if n),
+        notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[VP.ell])]
+                                                            if n and cspec.tracks),  # open loop: no tracking
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": {**cc.resolved, **design_record(sc)}},
         statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
@@ -404,7 +405,7 @@ def _state_dict(state: np.ndarray, prep: Prepared) -> dict[str, Any]:
 
 
 def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | str | Mapping | None = (), *,
-             warn: bool = True) -> Result:
+             warn: bool = False) -> Result:
     """Simulate a scenario and return its :class:`Result`.
 
     Parameters
@@ -418,7 +419,8 @@ def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | str 
         string, or a dict ``{dotted.key: value}`` of TOML values (NumPy scalars and arrays are
         converted, ``None`` is refused); None means none (see :func:`auvtrack.load_scenario`).
     warn : bool, optional
-        Emit the controller's set-up notes (e.g. an initial envelope widening) as warnings.
+        Also emit the set-up notes (e.g. the paper's initial envelope widening) as ``UserWarning``;
+        by default a run does not warn: its notes are in :attr:`Result.notes` (and ``run.json``).
 
     Returns
     -------
@@ -431,7 +433,8 @@ def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | str 
     ScenarioError
         Bad input, a one-line message naming the source and the field (a ``ValueError``).
     ValueError
-        The run plan or the controller's set-up refuses the scenario (:func:`prepare`).
+        The run plan or the controller's set-up refuses the scenario (:func:`prepare`), or a
+        plug-in law raises in its bounds-checked probe run (:func:`auvtrack.simulation.probe.probe`).
     SimulationInterrupted
         On Ctrl-C; its ``result`` holds the partial run.
 
@@ -441,8 +444,11 @@ def simulate(scenario: str | Mapping | Scenario, overrides: Sequence[str] | str 
     >>> res = auvtrack.simulate("paper", ["sim.duration=1"])  # doctest: +SKIP
     >>> res.to_pandas().head()  # doctest: +SKIP
     """
+    from .probe import probe
+
     sc = load_scenario(scenario, overrides)
     prep = prepare(sc)
+    probe(prep)
     if warn:
         for note in prep.notes:
             warnings.warn(note, stacklevel=2)

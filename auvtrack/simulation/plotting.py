@@ -500,6 +500,33 @@ def _draw_log_error_panel(ax, runs, a: str, t_range) -> None:
     ax.set_ylabel(rf"$|e_{a}|$ (m, log)")
 
 
+def ratio_text(value: float, digits: int = 2) -> str:
+    """``value`` with ``digits`` significant digits, more where rounding would carry it across 1.
+
+    A ratio |e|/rho of 0.9964 is inside the envelope: it reads ``0.996``, never ``1``; 1.004
+    reads ``1.004``, never ``1``.
+
+    Parameters
+    ----------
+    value : float
+        The ratio.
+    digits : int, optional
+        Significant digits when rounding keeps the value's side of 1.
+
+    Returns
+    -------
+    str
+        The text.
+    """
+    if not math.isfinite(value):
+        return str(value)
+    for n in range(digits, 16):
+        text = f"{value:.{n}g}"
+        if (float(text) < 1.0) == (value < 1.0) and (float(text) > 1.0) == (value > 1.0):
+            return text
+    return repr(value)
+
+
 def _draw_ratio_panel(ax, runs, t_range) -> list[str]:
     """|e_i| / rho_i per axis for the runs with an envelope (a run fails where it reaches 1); the peaks."""
     peaks = []
@@ -513,7 +540,7 @@ def _draw_ratio_panel(ax, runs, t_range) -> list[str]:
             ratio = np.abs(res[f"e{a}"][m]) / env[0]
             ax.plot(res.t[m], ratio, color=_color(i), linestyle=ls, linewidth=1.0, label=f"_{label} {a}")
             if np.isfinite(ratio).any():
-                run_peaks.append(f"{a} {np.nanmax(ratio):.2g}")
+                run_peaks.append(f"{a} {ratio_text(float(np.nanmax(ratio)))}")
         if run_peaks:
             peaks.append(f"{label}: " + ", ".join(run_peaks))
     ax.axhline(1.0, color="k", linewidth=0.9, label="_boundary")

@@ -255,6 +255,39 @@ class _HashingWriter:
         return {"sha256": self.sha.hexdigest(), "bytes": self.size}
 
 
+def csv_column(values: np.ndarray):
+    """One CSV column: Arrow's shortest round-trip text of each float64, whole numbers with ``.0``.
+
+    Arrow writes each value as the shortest decimal string that reads back to the same bits
+    (positional or exponent form, whichever is shorter: ``0.25``, ``1e-7``, ``1e+15``; ``nan``,
+    ``inf``, ``-inf``); a whole number it writes without a point (``0``, ``-3``) gets ``.0`` here,
+    so that every column reads back as floats (``pandas.read_csv`` would make an all-``0``
+    column integers).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        A 1-D float64 column (or a block of it).
+
+    Returns
+    -------
+    pyarrow.Array
+        The floats themselves when no value is a whole number, else their text.
+    """
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    v = np.ascontiguousarray(values, dtype=np.float64)
+    col = pa.array(v)
+    with np.errstate(invalid="ignore"):
+        whole = np.isfinite(v) & (v == np.trunc(v))
+    if not whole.any():
+        return col
+    text = pc.cast(col, pa.string())
+    plain = pc.and_(pa.array(whole), pc.invert(pc.match_substring(text, "e")))  # "3", not "3e+20"
+    return pc.if_else(plain, pc.binary_join_element_wise(text, ".0", ""), text)
+
+
 # ---------------------------------------------------------------- Result
 class Result:
     """Result of one simulation, modelled on python-control's response objects.
@@ -362,6 +395,11 @@ class Result:
         return self.status == "ok"
 
     @property
+    def notes(self) -> tuple[str, ...]:
+        """The set-up notes of the run (e.g. an initial envelope widening), from ``meta["notes"]``."""
+        return tuple(str(n) for n in self.meta.get("notes", ()))
+
+    @property
     def duration(self) -> float:
         """Logged time span ``t[-1] - t[0]`` (s); 0 for fewer than two samples."""
         t = self.t
@@ -401,6 +439,8 @@ class Result:
             parts.append("rmse[m]=(" + ", ".join(f"{a} {m[f'rmse_{a}']:.3g}" for a in "xyz") + ")")
         if all(f"max_abs_tau_{j}" in m for j in "uqr"):
             parts.append("max|tau|=(" + ", ".join(f"{j} {m[f'max_abs_tau_{j}']:.3g}" for j in "uqr") + ")")
+        if self.notes:
+            parts.append(f"{len(self.notes)} note{'s' if len(self.notes) > 1 else ''} (.notes)")
         return f"Result({', '.join(parts)})"
 
     # ---- conversion
@@ -455,14 +495,20 @@ class Result:
 
         Before each block ``stop()`` is asked whether to end there; returns the rows written.
         """
+        import pyarrow as pa
+        import pyarrow.csv as pa_csv
+
         fh.write((",".join(self._ch) + "\n").encode("utf-8"))
         arrays = list(self._ch.values())
+        names = [f"c{j}" for j in range(len(arrays))]  # the header is written above, unquoted
+        options = pa_csv.WriteOptions(include_header=False, quoting_style="none")
         for start in range(0, len(self), CSV_BLOCK_ROWS):
             if stop is not None and stop():
                 return start
-            # repr of a Python float is the shortest string that round-trips bit-exactly
-            cols = [list(map(repr, v[start:start + CSV_BLOCK_ROWS].tolist())) for v in arrays]
-            fh.write("".join(",".join(r) + "\n" for r in zip(*cols)).encode("utf-8"))
+            block = pa.table([csv_column(v[start:start + CSV_BLOCK_ROWS]) for v in arrays], names=names)
+            sink = pa.BufferOutputStream()
+            pa_csv.write_csv(block, sink, options)
+            fh.write(sink.getvalue().to_pybytes())
         return len(self)
 
     def _csv_text(self) -> str:
@@ -531,8 +577,9 @@ class Result:
         when several runs save to it at once (the last one to finish wins).  ``run.json`` records
         the SHA-256 and size of the other files under ``"files"``.
 
-        CSV values are Python float reprs (``nan``, ``inf`` spelled so): loading gives the same
-        bits, and identical results give byte-identical files.  In ``run.json`` every non-finite
+        CSV values are the shortest decimal strings that read back to the same bits
+        (:func:`csv_column`; ``nan``, ``inf`` spelled so): loading gives the same bits, and
+        identical results give byte-identical files.  In ``run.json`` every non-finite
         float is written as ``null`` and its JSON pointer recorded under ``"nonfinite"``
         (e.g. ``{"/metrics/settle_1mm_x": "inf"}``) so that :meth:`load` restores it.
         """
@@ -623,5 +670,5 @@ class Result:
                    doc.get("metrics") or {}, doc.get("meta"), version=doc.get("version"))
 
 
-__all__ = ["Result", "BASE_CHANNELS", "RUN_FILES", "to_jsonable", "restore_nonfinite", "run_folder_problem",
+__all__ = ["Result", "csv_column", "BASE_CHANNELS", "RUN_FILES", "to_jsonable", "restore_nonfinite", "run_folder_problem",
            "prepare_run_folder", "verify_run_folder", "FolderError"]

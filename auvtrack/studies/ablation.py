@@ -711,7 +711,10 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Abl
         "Omega = G = 1, so the `printed`, `omega` and `effective` adaptive laws are the same law there (one "
         f"configuration, `{config_label('none', DEFAULT_ESTIMATOR)}`).",
     ])
-    rep.heading("Findings")
+    if quick:  # a smoke test of the study's machinery: what it saw, not what it found
+        rep.heading(f"Observations of this quick run ({len(cfgs)} configurations, coarse grid): not findings")
+    else:
+        rep.heading("Findings")
     lines, tally = verdicts(scans, st)
     for d, _ in st.directions:
         rep.heading(f"{d} pulse", 3)

@@ -237,6 +237,23 @@ def run(out, *, quick: bool = False, progress: bool = False):
         ax.legend(fontsize=8)
     fig.tight_layout()
     rep.figure(fig, "zigzag", "zig-zag 15/20: heading change and rudder angle")
+    fig = Figure(figsize=(10, 6.4))
+    axes = fig.subplots(3, 2, sharex="col")
+    for col, which in enumerate(SCENARIOS):
+        for preset in PRESETS:
+            _, ch = runs[(which, preset)]
+            axes[0, col].plot(ch["t"], np.degrees(ch["delta_r"]), label=preset)
+            axes[1, col].plot(ch["t"], np.degrees(ch["delta_s"]), label=preset)
+            axes[2, col].plot(ch["t"], ch["rpm"], label=preset)
+        axes[0, col].set_title(which.replace("_", " "))
+        axes[2, col].set_xlabel("t (s)")
+    for row, label in enumerate(("rudder delta_r (deg)", "stern planes delta_s (deg)", "propeller (rpm)")):
+        axes[row, 0].set_ylabel(label)
+    for ax in axes.flat:
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    fig.tight_layout()
+    rep.figure(fig, "actuators", "fins and propeller of every run: rudder, stern planes (deg), propeller speed (rpm)")
     rep.heading("Turning circle")
     rep.table(["preset", "status", "advance (m)", "transfer (m)", "tactical diameter (m)", "steady diameter (m)",
                "speed at end (m/s)", "max \\|theta\\| (deg)"],
@@ -247,6 +264,9 @@ def run(out, *, quick: bool = False, progress: bool = False):
                "speed at end (m/s)"],
               [[r["preset"], r["status"], r["initial_turning_time"], r["period"], math.degrees(r["overshoot_1"]),
                 math.degrees(r["overshoot_2"]), r["speed_end"]] for r in rows if r["manoeuvre"] == "zigzag"], digits=3)
+    for which in SCENARIOS:
+        rep.scenario(scenario_path(which).read_text(encoding="utf-8"),
+                     f"auvtrack/data/scenarios/{SCENARIOS[which]} (flown on each preset with --set plant.preset=...)")
     return rep.write()
 
 

@@ -44,6 +44,31 @@ class StudySpec:
     options: tuple[str, ...] = ()
 
 
+def run_study(spec: StudySpec, out: Path, *, quick: bool = False, progress: bool = False, **options) -> Path:
+    """Run a registered study; a ``quick`` run's report opens with a banner and its results.json says ``"quick": true``.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study.
+    out : pathlib.Path
+        Output folder.
+    quick, progress : bool, optional
+        Passed to the study's ``run``.
+    **options
+        The study's own options (:attr:`StudySpec.options`).
+
+    Returns
+    -------
+    pathlib.Path
+        The report's path.
+    """
+    from ..report import quick_outputs
+
+    with quick_outputs(quick):
+        return spec.run(out, quick=quick, progress=progress, **options)
+
+
 def kinds_in(overrides: Iterable[str]) -> list[str]:
     """The controller kinds that ``controller.kind=...`` overrides name (for :func:`~auvtrack.simulation.compiling.compile_first`).
 

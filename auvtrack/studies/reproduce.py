@@ -32,7 +32,7 @@ from ..simulation.pipeline import prepare, run_prepared
 from ..simulation.result import Result
 from ..scenario import load_scenario
 from ..scenario import paper_scenario_path
-from ..report import Report
+from ..report import Report, metric_unit
 
 CONTROLLERS = (("FXTNTSMC", "fxtntsmc"), ("FTSMC", "ftsmc"))
 # the same comparison with both controllers tuned by one procedure (docs/tuning.md)
@@ -245,10 +245,12 @@ def _forms_report(rep: Report, forms: list[dict]) -> None:
 def _table_rows(full: dict[str, dict], steady: dict[str, dict], window: tuple[float, float]) -> list[list[str]]:
     keys = ([f"settle_{s}_{a}" for s in ("5cm", "1cm", "1mm") for a in AXES]
             + [f"rmse_{a}" for a in AXES] + [f"max_abs_{a}" for a in AXES] + [f"itae_{a}" for a in AXES]
-            + [f"max_abs_tau_{j}" for j in INPUTS] + [f"energy_tau_{j}" for j in INPUTS] + [f"tv_tau_{j}" for j in INPUTS])
-    rows = [[k, "whole run", _fmt(full["FXTNTSMC"][k]), _fmt(full["FTSMC"][k])] for k in keys]
+            + [f"max_abs_tau_{j}" for j in INPUTS] + [f"energy_tau_{j}" for j in INPUTS] + [f"tv_tau_{j}" for j in INPUTS]
+            + [f"t_sat_tau_{j}" for j in INPUTS])  # time with the input's command saturated
+    rows = [[k, metric_unit(k), "whole run", _fmt(full["FXTNTSMC"][k]), _fmt(full["FTSMC"][k])] for k in keys]
     for k in [f"rmse_{a}" for a in AXES] + [f"max_abs_{a}" for a in AXES] + [f"tv_tau_{j}" for j in INPUTS]:
-        rows.append([k, f"[{window[0]:g}, {window[1]:g}] s", _fmt(steady["FXTNTSMC"][k]), _fmt(steady["FTSMC"][k])])
+        rows.append([k, metric_unit(k), f"[{window[0]:g}, {window[1]:g}] s", _fmt(steady["FXTNTSMC"][k]),
+                     _fmt(steady["FTSMC"][k])])
     return rows
 
 
@@ -366,7 +368,7 @@ def _report(out: Path, runs, full, steady, vs, window) -> Report:
                   "Other forms of the law: the section on each form below.")
     rep.verdicts([(v.claim, v.verdict, v.evidence) for v in vs])
     rep.heading("Metrics")
-    rep.table(["metric", "window", "FXTNTSMC", "FTSMC"], _table_rows(full, steady, window))
+    rep.table(["metric (docs/metrics.md)", "unit", "window", "FXTNTSMC", "FTSMC"], _table_rows(full, steady, window))
     return rep
 
 

@@ -101,6 +101,9 @@ def test_reproduce_quick_writes_figures_tables_and_verdicts(tmp_path):
     # 3 claims x (paper gains, tuned gains, each form of the law)
     assert html.count('class="verdict ') == 3 * (2 + len(FORMS)) and "virtual point" in html
     assert summary in (tmp_path / "summary.md").read_text()
+    table = (tmp_path / "summary.md").read_text()
+    assert "| metric (docs/metrics.md) | unit | window |" in table
+    assert "| rmse_x | m | whole run |" in table and "| t_sat_tau_u | s | whole run |" in table
     m = json.loads((tmp_path / "metrics.json").read_text())
     assert m["status"] == {"FXTNTSMC": "ok", "FTSMC": "ok"}
     assert {v["verdict"] for v in m["verdicts"]} <= {"supported", "not supported", "mixed"}

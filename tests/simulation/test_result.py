@@ -175,11 +175,11 @@ def test_csv_header_and_bytes(tmp_path):
 
 
 def test_csv_is_streamed_in_blocks_with_the_same_bytes(tmp_path):
-    """The block-wise writer gives exactly the text of the one-shot formula, across block edges."""
-    from auvtrack.simulation.result import CSV_BLOCK_ROWS
+    """The block-wise writer gives exactly the text of each whole column formatted at once, across block edges."""
+    from auvtrack.simulation.result import CSV_BLOCK_ROWS, csv_column
 
     res = make_result(n=2 * CSV_BLOCK_ROWS + 17, extras=False)
-    cols = [list(map(repr, v.tolist())) for v in res.channels.values()]
+    cols = [[str(x) for x in csv_column(v).cast("string").to_pylist()] for v in res.channels.values()]
     expected = ",".join(res.names) + "\n" + "".join(",".join(r) + "\n" for r in zip(*cols))
     assert (res.save(tmp_path / "big") / "trajectory.csv").read_text() == expected
     assert Result(res.channels, {}, "ok", None, {}).save(tmp_path / "empty-scenario").joinpath(

@@ -36,3 +36,20 @@ def test_zigzag_of_a_sine_heading():
     assert m["period"] == pytest.approx(2 * math.pi / w, abs=1e-5)
     assert m["overshoot_1"] == pytest.approx(A - s, abs=1e-8) and m["overshoot_2"] == pytest.approx(A - s, abs=1e-8)
     assert m["reversals"] >= 4
+
+
+def test_the_quick_study_report_shows_its_own_scenarios_fins_and_rpm(tmp_path):
+    """The report closes with the manoeuvre scenarios (not the paper's Section 4), plots the fins and
+    the propeller of every run, and is marked quick."""
+    import json
+
+    from auvtrack.report import QUICK_BANNER
+    from auvtrack.studies.registry import get_study, run_study
+
+    report = run_study(get_study("manoeuvres"), tmp_path, quick=True)
+    text = report.read_text()
+    assert QUICK_BANNER in text and json.loads((tmp_path / "results.json").read_text())["quick"] is True
+    assert "fins and propeller of every run" in text and (tmp_path / "figures" / "actuators.png").is_file()
+    closing = text[text.index("## Scenario and version"):]
+    assert 'name = "remus100_turning_circle"' in closing and 'name = "remus100_zigzag"' in closing
+    assert "Section 4" not in closing

@@ -211,6 +211,7 @@ def test_quick_ablation_end_to_end(quick_run):
     assert report == out / "report.md" and report.exists()
     text = report.read_text()
     assert "Survival per configuration" in text and "figures/survival.png" in text and "### heave pulse" in text
+    assert "## Findings" not in text and "## Observations of this quick run (3 configurations" in text
     assert (out / "figures" / "survival.png").exists()
     data = json.loads((out / "results.json").read_text())
     st_ = ablation.AblationSettings.quick()

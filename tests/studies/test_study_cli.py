@@ -104,3 +104,13 @@ class _R:
 ])
 def test_failure_cause_classification(failure, cause):
     assert failure_cause(_R(failure)) == cause
+
+
+def test_metric_units_name_each_axis_and_input():
+    from auvtrack.metrics import METRIC_NAMES
+    from auvtrack.report import metric_unit
+
+    assert metric_unit("rmse_x") == "m" and metric_unit("settle_5cm_y") == "s" and metric_unit("itae_z") == "m*s^2"
+    assert metric_unit("max_abs_tau_u") == "N" and metric_unit("max_abs_tau_q") == "N*m"
+    assert metric_unit("energy_tau_r") == "N^2*m^2*s" and metric_unit("tv_tau_u") == "N/s"
+    assert all(metric_unit(n) for n in METRIC_NAMES)  # every metric has a unit
