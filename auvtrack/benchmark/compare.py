@@ -22,6 +22,7 @@ import numpy as np
 from .._atomic import atomic_file
 from . import execute as runner
 from . import leaderboard as lb
+from .across_tasks import aggregate_analysis
 from .suite import (DEFAULT_SUITE, ControllerEntry, Suite, check_competitor, load_suite,
                     resolve_controllers)
 
@@ -89,7 +90,8 @@ def analyse(df, suite: Suite) -> dict[str, Any]:
     dict
         ``cells``, ``pooled_tier``, ``pooled``, ``scores`` (``cells`` keyed ``"tier/task"``),
         ``weights``, ``criteria`` and ``metrics`` (the weighted criteria, without ``failure``),
-        ``rank_intervals``, ``paired``.
+        ``rank_intervals``, ``paired`` and ``aggregates`` (across tasks:
+        :func:`~auvtrack.benchmark.across_tasks.aggregate_analysis`).
     """
     f = suite.file
     metrics = f.scoring.metrics()
@@ -110,6 +112,7 @@ def analyse(df, suite: Suite) -> dict[str, Any]:
         "metrics": list(metrics),
         "rank_intervals": ranks,
         "paired": lb.paired_comparisons(df, criteria=("failure", *metrics)),
+        "aggregates": aggregate_analysis(df, suite, list(dict.fromkeys(df["controller"]))),
     }
 
 

@@ -15,6 +15,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .leaderboard import metric_info
+from .report_aggregates import write_aggregates_section
 from ..report import Report, fmt, write_json
 from .suite import ControllerEntry, Suite
 
@@ -277,6 +278,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
                   "mean over its tasks, the overall score the mean over the tiers. Lower is better. Rank "
                   "interval and P(best): the rule applied to resamples of the seed indices.")
     rep.figure(figure_leaderboard(analysis, tiers), "leaderboard", "Overall and per-tier scores; rank intervals")
+    write_aggregates_section(rep, analysis["aggregates"], order)
 
     rep.heading("Settings")
     rep.table(["setting", "value"], _settings_rows(suite))
@@ -351,7 +353,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
         "leaderboard": [{"controller": c, **scores["overall"][c], "rank_interval": analysis["rank_intervals"][c],
                          "tiers": {t: scores["tiers"][t][c] for t in tiers}} for c in order],
         "representative_seeds": {f"{k[0]}/{k[1]}": v for k, v in seeds.items()},
-        **{k: analysis[k] for k in ("cells", "pooled_tier", "pooled", "scores", "weights", "paired")},
+        **{k: analysis[k] for k in ("cells", "pooled_tier", "pooled", "scores", "weights", "paired", "aggregates")},
         "timing": timing,
     })
     return report
