@@ -173,3 +173,15 @@ def test_analyse_ranks_and_tests_the_weighted_criteria_only(tmp_path):
     assert "itae" not in res["cells"][0] and res["cells"][0]["xtrack_rmse"]["median"] > 0
     assert res["scores"]["order"][0] == "A"  # the smallest cross-track error, equal elsewhere
     assert res["aggregates"]["estimates"]["iqm"]["A"]["point"] < res["aggregates"]["estimates"]["iqm"]["B"]["point"]
+
+
+def test_the_weights_in_the_docs_are_the_suite_s():
+    """docs/benchmark.md's table of v2's leaderboard weights is the shipped [scoring] table."""
+    import re
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "benchmark.md").read_text()
+    table = text[text.index("| criterion | weight | what |"):].split("\n\n")[0]
+    doc: dict[str, float] = {}
+    for names, weight in re.findall(r"^\s*\| ((?:`\w+`(?:, )?)+) \| ([\d.]+)", table, flags=re.M):
+        doc.update({n: float(weight) for n in re.findall(r"`(\w+)`", names)})
+    assert doc == load_suite("auv-track-v2", check=False).file.scoring.weights()
