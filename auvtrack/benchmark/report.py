@@ -16,6 +16,7 @@ import numpy as np
 
 from .leaderboard import metric_info
 from .report_aggregates import write_aggregates_section
+from .report_competitors import TUNING_COLUMNS, failure_cause_rows, gain_rows, tuning_rows
 from ..report import Report, fmt, write_json
 from .suite import ControllerEntry, Suite
 
@@ -285,6 +286,14 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
     rep.table(["controller", "gains"], [[e.label, e.gains] for e in entries])
     if any("defaults" in e.gains for e in entries):
         rep.paragraph("Controllers without a tuned gain preset run with their package defaults (above).")
+    rep.paragraph("Tuning of each competitor, from its gain preset's provenance (`auvtrack tune` writes it; "
+                  "docs/tuning.md): what it was tuned on, the budget and what it cost.")
+    rep.table(list(TUNING_COLUMNS), tuning_rows(entries))
+    gains = gain_rows(entries)
+    if gains:
+        rep.paragraph("Gains the presets change, next to the published values (the controllers' defaults, "
+                      "docs/controllers.md):")
+        rep.table(["competitor", "gain", "published", "preset", "preset name"], gains)
     rep.table(["task", "duration (s)", "description"],
               [[t, suite.duration(t), suite.file.tasks[t].description] for t in tasks])
     rep.table(["tier", "description"], [[t, suite.file.tiers[t].description] for t in tiers])
@@ -298,6 +307,13 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
         rows.append([r["tier"], r["controller"], f"{r['failures']}/{r['n']}", _pct(r["failure_rate"]),
                      _ci(*r["failure_ci"], 3), causes])
     rep.table(["tier", "controller", "failed", "rate", "Wilson 95 %", "causes"], rows)
+    head, why = failure_cause_rows(analysis["pooled_tier"])
+    if why:
+        rep.paragraph("Why it failed: the failed runs of every tier and controller by cause (pooled over the "
+                      "tasks; `unknown`: a failure without a recorded cause).")
+        rep.table(head, why)
+    else:
+        rep.paragraph("No run failed.")
     setup = df[df["cause"] == "setup"]
     if len(setup):
         rep.paragraph("Runs refused at set-up (counted as failures): " + "; ".join(

@@ -185,3 +185,34 @@ def test_the_weights_in_the_docs_are_the_suite_s():
     for names, weight in re.findall(r"^\s*\| ((?:`\w+`(?:, )?)+) \| ([\d.]+)", table, flags=re.M):
         doc.update({n: float(weight) for n in re.findall(r"`(\w+)`", names)})
     assert doc == load_suite("auv-track-v2", check=False).file.scoring.weights()
+
+
+# ------------------------------------------------------------------ the report's competitor and failure tables
+def test_tuning_and_gain_tables_read_the_presets_provenance():
+    from auvtrack.benchmark.report_competitors import TUNING_COLUMNS, gain_rows, tuning_rows
+    from auvtrack.benchmark.suite import resolve_controllers
+    from auvtrack.control import CONTROLLERS
+    from auvtrack.control.gain_presets import get_gain_preset
+
+    entries = resolve_controllers(["pid", "sta"], None, "{kind}_remus100_auv-track-v1")
+    rows = {r[0]: r for r in tuning_rows(entries)}
+    assert all(len(r) == len(TUNING_COLUMNS) for r in rows.values())
+    prov = get_gain_preset("pid_remus100_auv-track-v1").provenance
+    assert rows["pid"][2] == prov["tool"] and str(prov["budget_runs"]) in rows["pid"][4]
+    assert rows["sta"][1:3] == ["package defaults", "not tuned"]  # no such preset for sta
+    gains = gain_rows(entries)
+    preset = get_gain_preset("pid_remus100_auv-track-v1").gains
+    published = CONTROLLERS["pid"].params.model_validate({"kind": "pid"})
+    assert {r[1] for r in gains} == {k for k, v in preset.items() if getattr(published, k) != v}
+    assert all(r[0] == "pid" for r in gains)
+
+
+def test_why_it_failed_counts_add_up_and_unknown_causes_show():
+    from auvtrack.benchmark.report_competitors import failure_cause_rows
+
+    df = pd.DataFrame({"tier": ["a"] * 5 + ["b"] * 2, "controller": ["x", "x", "x", "y", "y", "x", "x"],
+                       "status": ["failed", "failed", "ok", "failed", "ok", "ok", "ok"],
+                       "cause": ["pitch_limit", "", "", "divergence", "", "", ""]})
+    head, rows = failure_cause_rows(lb.pooled_failures(df, ("tier", "controller")))
+    assert head == ["tier", "controller", "failed", "divergence", "pitch_limit", "unknown"]
+    assert rows == [["a", "x", "2/3", 0, 1, 1], ["a", "y", "1/2", 1, 0, 0]]  # tier b: no failure, no row
