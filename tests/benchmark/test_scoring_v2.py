@@ -216,3 +216,31 @@ def test_why_it_failed_counts_add_up_and_unknown_causes_show():
     head, rows = failure_cause_rows(lb.pooled_failures(df, ("tier", "controller")))
     assert head == ["tier", "controller", "failed", "divergence", "pitch_limit", "unknown"]
     assert rows == [["a", "x", "2/3", 0, 1, 1], ["a", "y", "1/2", 1, 0, 0]]  # tier b: no failure, no row
+
+
+def test_a_v2_like_comparison_end_to_end(tmp_path):
+    """A tiny suite with v2's kind of [scoring]: the report ranks path following, carries the aggregates
+    across tasks, the tuning table and the failure causes; runs.parquet marks failed runs' criteria inf."""
+    import json
+
+    from auvtrack.benchmark.compare import compare
+
+    suite = _suite(tmp_path)
+    res = compare(suite, controllers=["pid", REFERENCE], quick=True, out=tmp_path / "out", progress=False, workers=1)
+    assert res.complete
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert doc["criteria"] == ["failure", "xtrack_rmse", "vtrack_rmse", "rmse", "energy", "tv"]
+    assert set(doc["metrics"]) == {"xtrack_rmse", "vtrack_rmse", "rmse", "energy", "tv"}
+    agg = doc["aggregates"]
+    assert agg["score"] == "xtrack_rmse" and agg["estimates"] is not None
+    assert set(agg["estimates"]["iqm"]) == {"pid", REFERENCE}
+    assert {(r["x"], r["y"]) for r in agg["improvement"]} == {("pid", REFERENCE), (REFERENCE, "pid")}
+    runs = pd.read_parquet(tmp_path / "out" / "runs.parquet")
+    assert np.all(np.isinf(runs.loc[runs["status"] != "ok", "xtrack_rmse"]))
+    assert (runs["cause"][runs["status"] != "ok"] != "").all()  # every failure has a cause
+    md = (tmp_path / "out" / "report.md").read_text()
+    for text in ("## Aggregates across tasks", "objective (train / validation)", "xtrack_rmse median"):
+        assert text in md, text
+    assert ("Why it failed" in md) == bool((runs["status"] != "ok").any())
+    html = (tmp_path / "out" / "report.html").read_text()
+    assert "data:image/png;base64," in html and "<img src=\"figures/" not in html  # self-contained
