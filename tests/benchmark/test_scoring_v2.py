@@ -244,3 +244,10 @@ def test_a_v2_like_comparison_end_to_end(tmp_path):
     assert ("Why it failed" in md) == bool((runs["status"] != "ok").any())
     html = (tmp_path / "out" / "report.html").read_text()
     assert "data:image/png;base64," in html and "<img src=\"figures/" not in html  # self-contained
+    from tools.findings import block_compare_v2
+
+    doc["_provenance"] = {"command": "auvtrack compare --suite tiny", "stored": "now"}
+    block = block_compare_v2(doc)
+    assert "IQM of normalised `xtrack_rmse`" in block and "| `pid` |" in block and f"| `{REFERENCE}` |" in block
+    assert f"{int((runs['status'] != 'ok').sum())} runs failed, 0 of them without a recorded cause" in block
+    assert "no run on the calm truth tiers" in block  # the tiny suite has no truth tier
