@@ -690,6 +690,57 @@ def block_performance(b: dict) -> str:
     return head + "\n\n" + "\n".join(rows)
 
 
+CALM_TRUTHS = ("truth_prestero", "truth_fossen")
+"""The calm truth tiers of auv-track-v2 (the issue's acceptance: the LOS autopilot and PID fail no run there)."""
+BASELINES = ("los_autopilot", "pid")
+XTRACK_TARGET = 0.5  # m, the acceptance's bound on the median cross-track error
+
+
+def _calm_check(cv: dict) -> list[str]:
+    cells = {(c["tier"], c["task"], c["controller"]): c for c in cv["cells"]}
+    out = []
+    for ctrl in BASELINES:
+        mine = [c for (t, _, k), c in cells.items() if t in CALM_TRUTHS and k == ctrl]
+        if not mine:
+            out.append(f"* `{ctrl}`: no run on the calm truth tiers ({', '.join(CALM_TRUTHS)}).")
+            continue
+        fails = sum(c["failures"] for c in mine)
+        runs = sum(c["n"] for c in mine)
+        worst = max(mine, key=lambda c: c["xtrack_rmse"]["median"])
+        ok = fails == 0 and worst["xtrack_rmse"]["median"] <= XTRACK_TARGET
+        out.append(f"* `{ctrl}` on the calm truths: {fails} of {runs} runs failed; largest cell median `xtrack_rmse` "
+                   f"{_f(worst['xtrack_rmse']['median'])} m ({worst['tier']}, {worst['task']}): the acceptance "
+                   f"(no failure, every median <= {XTRACK_TARGET:g} m) {'holds' if ok else 'does not hold'}.")
+    return out
+
+
+def block_compare_v2(cv: dict) -> str:
+    """The auv-track-v2 leaderboard, its aggregates and the calm-truth acceptance check, from ``compare``'s results.json."""
+    s, t = cv["suite"], cv["timing"]
+    agg = cv.get("aggregates") or {}
+    iqm = (agg.get("estimates") or {}).get("iqm", {})
+    pooled = {r["controller"]: r for r in cv["pooled"]}
+    rows = ["| rank | controller | score | rank 95 % CI | failure rate | IQM of normalised `"
+            f"{agg.get('score', '?')}` [95 %] | gains |", "|---|---|---|---|---|---|---|"]
+    gains = {c["label"]: c["gains"] for c in cv["controllers"]}
+    for r in cv["leaderboard"]:
+        c = r["controller"]
+        q = iqm.get(c)
+        rows.append(f"| {r['rank']:g} | `{c}` | {r['score']:.2f} | [{r['rank_interval']['low']:g}, "
+                    f"{r['rank_interval']['high']:g}] | {100 * pooled[c]['failure_rate']:.1f} % | "
+                    + (f"{_f(q['point'])} [{_f(q['low'])}, {_f(q['high'])}]" if q else "n/a") + f" | {gains[c]} |")
+    fails = sum(r["failures"] for r in cv["pooled"])
+    unknown = sum(r["causes"].get("unknown", 0) for r in cv["pooled"])
+    head = (f"`{cv['_provenance']['command']}`, stored {cv['_provenance']['stored']} (sources "
+            f"{cv['source_hash'][:12]}): suite {s['name']} version {s['version']}, {s['seeds']} seeds per cell, "
+            f"{t['runs']} runs in {t['runs_seconds']:.0f} s after {t['compile_seconds']:.0f} s of compilation "
+            f"({t['batch_backend']}, {t['cpu_count']} cores, load average {t['load_average_start']} at the start). "
+            f"Score: the rank-based rule on the weighted criteria ({', '.join(cv['criteria'])}); normalisation of "
+            f"the aggregates: {agg.get('normalisation', 'none')}.")
+    tail = [f"{fails} runs failed, {unknown} of them without a recorded cause."] + _calm_check(cv)
+    return head + "\n\n" + "\n".join(rows) + "\n\n" + "\n".join(tail)
+
+
 # ------------------------------------------------------------------ rendering
 def blocks() -> dict[str, tuple[str, Callable[[], str]]]:
     """Generated block name -> (document key, renderer)."""

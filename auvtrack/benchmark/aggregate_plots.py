@@ -1,6 +1,6 @@
 """Figures of the aggregates across tasks (:mod:`auvtrack.benchmark.aggregates`), for the benchmark report.
 
-Matplotlib ``Figure`` objects (no pyplot, as :mod:`auvtrack.studies.compare_report`): performance
+Matplotlib ``Figure`` objects (no pyplot, as :mod:`auvtrack.benchmark.report`): performance
 profiles with their bootstrap bands, probabilities of improvement with their intervals, and
 the interval estimates of the aggregates.  Infinite values (aggregates of controllers that fail
 often) are drawn at the right edge of their panel with an arrow and labelled ``inf``.

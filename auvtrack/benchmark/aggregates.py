@@ -21,9 +21,9 @@ library), on the benchmark's runs (``docs/benchmark.md``, "Aggregates across tas
 
 Conventions: **lower is better** (errors, normalised errors); ``nan`` and every metric of a run
 whose ``status`` is not ``"ok"`` count as ``+inf`` (a failed run is worse than every completed
-one), as in :func:`auvtrack.studies.leaderboard.derive_metrics`.  Interval bounds are order
+one), as in :func:`auvtrack.benchmark.leaderboard.derive_metrics`.  Interval bounds are order
 statistics of the replicates (the inverse empirical CDF, NumPy's ``inverted_cdf``, as in
-:func:`auvtrack.studies.statistics.bootstrap_median`, with the rank computed so that a level of
+:func:`auvtrack.benchmark.statistics.bootstrap_median`, with the rank computed so that a level of
 0.95 means 95 %), so infinite replicates are handled exactly; rliable interpolates linearly
 (through ``arch``), which is undefined between two infinities.
 
@@ -430,7 +430,7 @@ def _estimate(point: float, rep: np.ndarray, confidence: float) -> Estimate:
 
 
 def _difference(a: np.ndarray | float, b: np.ndarray | float) -> np.ndarray:
-    """``a - b`` with two infinities a tie (0), as :mod:`auvtrack.studies.statistics` does."""
+    """``a - b`` with two infinities a tie (0), as :mod:`auvtrack.benchmark.statistics` does."""
     x, y = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     with np.errstate(invalid="ignore"):
         d = x - y

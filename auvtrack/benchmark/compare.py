@@ -22,7 +22,8 @@ import numpy as np
 from .._atomic import atomic_file
 from . import execute as runner
 from . import leaderboard as lb
-from .suite import (DEFAULT_SUITE, CRITERIA, ControllerEntry, Suite, check_competitor, load_suite,
+from .across_tasks import aggregate_analysis
+from .suite import (DEFAULT_SUITE, ControllerEntry, Suite, check_competitor, load_suite,
                     resolve_controllers)
 
 __all__ = ["compare", "CompareOutcome", "analyse", "representative_seeds", "default_out"]
@@ -88,12 +89,16 @@ def analyse(df, suite: Suite) -> dict[str, Any]:
     -------
     dict
         ``cells``, ``pooled_tier``, ``pooled``, ``scores`` (``cells`` keyed ``"tier/task"``),
-        ``rank_intervals``, ``paired``.
+        ``weights``, ``criteria`` and ``metrics`` (the weighted criteria, without ``failure``),
+        ``rank_intervals``, ``paired`` and ``aggregates`` (across tasks:
+        :func:`~auvtrack.benchmark.across_tasks.aggregate_analysis`).
     """
     f = suite.file
-    cells = lb.cell_statistics(df, seed=f.seed, confidence=f.confidence, n_resamples=suite.bootstrap_resamples)
+    metrics = f.scoring.metrics()
+    cells = lb.cell_statistics(df, seed=f.seed, confidence=f.confidence, n_resamples=suite.bootstrap_resamples,
+                               metrics=metrics)
     weights = f.scoring.weights()
-    scores = lb.score_table(lb.criteria_table(cells), weights)
+    scores = lb.score_table(lb.criteria_table(cells, metrics), weights)
     ranks = lb.rank_bootstrap(df, weights, seed=f.seed, n_resamples=max(50, suite.bootstrap_resamples // 10),
                               confidence=f.confidence)
     return {
@@ -103,15 +108,18 @@ def analyse(df, suite: Suite) -> dict[str, Any]:
         "scores": {"cells": {f"{k[0]}/{k[1]}": v for k, v in scores["cells"].items()},
                    "tiers": scores["tiers"], "overall": scores["overall"], "order": scores["order"]},
         "weights": weights,
+        "criteria": list(f.scoring.criteria()),
+        "metrics": list(metrics),
         "rank_intervals": ranks,
-        "paired": lb.paired_comparisons(df, criteria=CRITERIA),
+        "paired": lb.paired_comparisons(df, criteria=("failure", *metrics)),
+        "aggregates": aggregate_analysis(df, suite, list(dict.fromkeys(df["controller"]))),
     }
 
 
-def representative_seeds(df) -> dict[tuple[str, str], int]:
-    """The typical seed index of each (tier, task): the median, over seeds, of the controllers' median RMSE.
+def representative_seeds(df, metric: str = "rmse") -> dict[tuple[str, str], int]:
+    """The typical seed index of each (tier, task): the median, over seeds, of the controllers' median error.
 
-    For each seed index the median RMSE over the controllers is taken (failures ``inf``); the
+    For each seed index the median of ``metric`` over the controllers is taken (failures ``inf``); the
     representative seed is the one at the lower median of these values (ties: the smallest
     index), so every controller is shown on the same, typical conditions.
 
@@ -119,6 +127,8 @@ def representative_seeds(df) -> dict[tuple[str, str], int]:
     ----------
     df : pandas.DataFrame
         Runs with the derived metrics.
+    metric : str, optional
+        The error (the suite's primary metric, :meth:`~auvtrack.benchmark.suite.Scoring.primary`).
 
     Returns
     -------
@@ -127,7 +137,7 @@ def representative_seeds(df) -> dict[tuple[str, str], int]:
     """
     out = {}
     for (tier, task), g in df.groupby(["tier", "task"], sort=False):
-        per = g.groupby("seed_index")["rmse"].median().sort_index()
+        per = g.groupby("seed_index")[metric].median().sort_index()
         order = np.lexsort((per.index.to_numpy(), per.to_numpy()))
         out[(tier, task)] = int(per.index[order[(len(order) - 1) // 2]])
     return out
@@ -226,11 +236,11 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
     if not ex.complete:
         return CompareOutcome(folder, False, None, ex, 0.0)
     t0 = time.perf_counter()
-    df = lb.derive_metrics(runner.read_runs(folder), s.file.metrics.settle)
+    df = lb.derive_metrics(runner.read_runs(folder), s.file.metrics.settle, s.file.scoring.criteria())
     with atomic_file(folder / runner.RUNS_FILE) as fh:  # the runs with the benchmark's metrics
         df.to_parquet(fh, index=False)
     analysis = analyse(df, s)
-    seeds = representative_seeds(df)
+    seeds = representative_seeds(df, s.file.scoring.primary())
     reps = _representative_runs(s, ents, seeds, workers)
     timing = {"runs_seconds": ex.seconds, "compile_seconds": ex.compile_seconds, "chunks_run": ex.chunks_run,
               "chunks_resumed": ex.chunks_skipped, "runs": ex.runs, "backend": "dask" if (scheduler or client)

@@ -6,7 +6,8 @@ Definitions (``docs/benchmark.md``):
   (``docs/metrics.md``, whole run): ``rmse`` = sqrt(sum_a rmse_a^2) (m, the RMS of |e|),
   ``itae`` = sum_a itae_a (m s^2), ``max_error`` = max_a max|e_a| (m), ``settling`` = max_a
   settle_<thr>_a (s; inf if an axis never stays below the threshold), ``energy`` = sum_j
-  energy_tau_j and ``tv`` = sum_j tv_tau_j over the inputs u, q, r.  A run that did not
+  energy_tau_j and ``tv`` = sum_j tv_tau_j over the inputs u, q, r; a suite's ``[scoring]`` can
+  name engine metrics (``xtrack_rmse``, ``act_rate_q``, ...) as criteria too.  A run that did not
   complete (any failure) has ``inf`` in every metric: it is worse than every completed run.
 * **Cells** (:func:`cell_statistics`): per tier x task x controller, the failure rate with its
   Wilson interval and the failures by cause, and the median of each metric over *all* seeds
@@ -37,7 +38,7 @@ from . import statistics as st
 from .suite import CRITERIA, METRICS
 
 __all__ = ["derive_metrics", "cell_statistics", "pooled_failures", "criteria_table", "score_table",
-           "rank_bootstrap", "paired_comparisons", "METRIC_INFO"]
+           "rank_bootstrap", "paired_comparisons", "METRIC_INFO", "metric_info"]
 
 METRIC_INFO: dict[str, tuple[str, str]] = {
     "rmse": ("RMSE of |e|", "m"),
@@ -49,12 +50,51 @@ METRIC_INFO: dict[str, tuple[str, str]] = {
 }
 """Metric name -> (description, unit)."""
 
+_ENGINE_INFO: dict[str, str] = {
+    "xtrack_rmse": "RMS cross-track (horizontal) distance to the path",
+    "xtrack_max": "largest cross-track distance to the path",
+    "vtrack_rmse": "RMS vertical distance to the path",
+    "along_rmse": "RMS along-path error (timing on the path)",
+    "act_rms": "RMS position of the {}", "act_max": "largest position of the {}",
+    "act_rate": "rate of the {}", "t_act_limit": "time at the limit of the {}",
+}
+"""Descriptions of the engine metrics a suite can score (``docs/metrics.md``); ``{}``: the actuator."""
+_ACTUATORS = {"u": "propeller", "q": "stern planes", "r": "rudder"}
+
+
+def metric_info(name: str) -> tuple[str, str]:
+    """Description and unit of a criterion: a derived metric (:data:`METRIC_INFO`) or an engine metric.
+
+    Parameters
+    ----------
+    name : str
+        A metric name (``rmse``, ``xtrack_rmse``, ``xtrack_rmse_late``, ``act_rate_q``, ...).
+
+    Returns
+    -------
+    (str, str)
+        Description and unit (engine metrics: ``docs/metrics.md``; the name itself when it has
+        no description here).
+    """
+    from ..metrics import METRIC_UNITS
+
+    if name in METRIC_INFO:
+        return METRIC_INFO[name]
+    base, late = (name[:-5], " (second half of the run)") if name.endswith("_late") else (name, "")
+    if base in _ENGINE_INFO:
+        return _ENGINE_INFO[base] + late, METRIC_UNITS[base]
+    family, _, j = base.rpartition("_")
+    if family in _ENGINE_INFO and j in _ACTUATORS:
+        return _ENGINE_INFO[family].format(_ACTUATORS[j]), METRIC_UNITS[family]
+    unit = next((u for k, u in METRIC_UNITS.items() if family.startswith(k)), "")
+    return name, unit
+
 
 def _rng(seed: int, purpose: str) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence([int(seed), zlib.crc32(purpose.encode())]))
 
 
-def derive_metrics(runs, settle: str = "5cm"):
+def derive_metrics(runs, settle: str = "5cm", criteria: Sequence[str] = ()):
     """Add the benchmark's per-run metrics (:data:`METRIC_INFO`) to a runs table.
 
     Parameters
@@ -63,6 +103,9 @@ def derive_metrics(runs, settle: str = "5cm"):
         One row per run with ``status`` and the engine's metric columns (``rmse_x``, ...).
     settle : str, optional
         Settling threshold label (``5cm``, ``1cm``, ``1mm``).
+    criteria : sequence of str, optional
+        Engine metric columns the suite scores (its ``[scoring]``): set to ``inf`` for a failed
+        run (and a ``nan`` value), like the derived metrics.
 
     Returns
     -------
@@ -79,7 +122,7 @@ def derive_metrics(runs, settle: str = "5cm"):
     df["energy"] = sum(df[f"energy_tau_{j}"] for j in inputs)
     df["tv"] = sum(df[f"tv_tau_{j}"] for j in inputs)
     bad = (df["status"] != "ok").to_numpy()
-    for m in METRICS:
+    for m in dict.fromkeys((*METRICS, *(c for c in criteria if c != "failure"))):
         col = df[m].to_numpy(dtype=float, copy=True)
         col[bad | np.isnan(col)] = math.inf
         df[m] = col
@@ -91,7 +134,8 @@ def _causes(group) -> dict[str, int]:
     return {str(k): int(v) for k, v in sorted(failed["cause"].replace("", "unknown").value_counts().items())}
 
 
-def cell_statistics(df, *, seed: int, confidence: float = 0.95, n_resamples: int = 2000) -> list[dict]:
+def cell_statistics(df, *, seed: int, confidence: float = 0.95, n_resamples: int = 2000,
+                    metrics: Sequence[str] = METRICS) -> list[dict]:
     """Failure rate (Wilson interval), causes and bootstrapped medians per tier x task x controller.
 
     Parameters
@@ -105,6 +149,8 @@ def cell_statistics(df, *, seed: int, confidence: float = 0.95, n_resamples: int
         Level of the intervals.
     n_resamples : int, optional
         Bootstrap resamples.
+    metrics : sequence of str, optional
+        The metrics whose medians are estimated (the suite's weighted criteria).
 
     Returns
     -------
@@ -121,7 +167,7 @@ def cell_statistics(df, *, seed: int, confidence: float = 0.95, n_resamples: int
                                "failure_rate": k / n, "failure_ci": list(st.wilson_interval(k, n, confidence)),
                                "causes": _causes(g)}
         ok = g["status"] == "ok"
-        for m in METRICS:
+        for m in metrics:
             vals = g[m].to_numpy(dtype=float)
             est = st.bootstrap_median(vals, _rng(seed, f"bootstrap/{tier}/{task}/{ctrl}/{m}"),
                                       confidence=confidence, n_resamples=n_resamples)
@@ -159,13 +205,16 @@ def pooled_failures(df, by: Sequence[str], confidence: float = 0.95) -> list[dic
     return out
 
 
-def criteria_table(cells: Sequence[Mapping]) -> dict[tuple[str, str], dict[str, dict[str, float]]]:
+def criteria_table(cells: Sequence[Mapping], metrics: Sequence[str] = METRICS
+                   ) -> dict[tuple[str, str], dict[str, dict[str, float]]]:
     """``{(tier, task): {controller: {criterion: value}}}`` from :func:`cell_statistics` records.
 
     Parameters
     ----------
     cells : sequence of dict
         Cell records.
+    metrics : sequence of str, optional
+        The metrics of the records (as given to :func:`cell_statistics`).
 
     Returns
     -------
@@ -174,7 +223,7 @@ def criteria_table(cells: Sequence[Mapping]) -> dict[tuple[str, str], dict[str, 
     """
     table: dict[tuple[str, str], dict[str, dict[str, float]]] = {}
     for c in cells:
-        row = {"failure": float(c["failure_rate"])} | {m: float(c[m]["median"]) for m in METRICS}
+        row = {"failure": float(c["failure_rate"])} | {m: float(c[m]["median"]) for m in metrics}
         table.setdefault((c["tier"], c["task"]), {})[c["controller"]] = row
     return table
 
@@ -266,7 +315,7 @@ def rank_bootstrap(df, weights: Mapping[str, float], *, seed: int, n_resamples: 
     idx = rng.integers(0, n, size=(n_resamples, n))
     pos = {s: i for i, s in enumerate(seeds)}
     controllers = list(dict.fromkeys(df["controller"]))
-    crit = [c for c in CRITERIA if weights.get(c, 0) > 0]
+    crit = [c for c in weights if weights[c] > 0]
     # per cell and controller: the criteria of every resample
     stats: dict[tuple[str, str], dict[str, dict[str, np.ndarray]]] = {}
     for (tier, task, ctrl), g in df.groupby(["tier", "task", "controller"], sort=False):
@@ -276,8 +325,8 @@ def rank_bootstrap(df, weights: Mapping[str, float], *, seed: int, n_resamples: 
             raise ValueError(f"cell {tier}/{task}/{ctrl}: {len(g)} runs, expected one per seed index ({n})")
         fail = (g["status"] != "ok").to_numpy(dtype=float)
         rec = {"failure": fail[idx].mean(axis=1)}
-        for m in METRICS:
-            if m in crit:
+        for m in crit:
+            if m != "failure":
                 rec[m] = np.median(g[m].to_numpy(dtype=float)[idx], axis=1)
         stats.setdefault((tier, task), {})[ctrl] = rec
     ranks = np.empty((n_resamples, len(controllers)))

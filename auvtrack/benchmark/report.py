@@ -14,9 +14,11 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .leaderboard import METRIC_INFO
+from .leaderboard import metric_info
+from .report_aggregates import write_aggregates_section
+from .report_competitors import TUNING_COLUMNS, failure_cause_rows, gain_rows, tuning_rows
 from ..report import Report, fmt, write_json
-from .suite import CRITERIA, METRICS, ControllerEntry, Suite
+from .suite import ControllerEntry, Suite
 
 __all__ = ["write_report", "figure_leaderboard", "figure_failures", "figure_distribution", "figure_trajectories"]
 
@@ -101,7 +103,7 @@ def figure_distribution(df, metric: str, tiers: Sequence[str], controllers: Sequ
     colors = _colors(controllers)
     fig = Figure(figsize=(2.6 * len(tiers) + 1, 3.4))
     axes = np.atleast_1d(fig.subplots(1, len(tiers), sharey=True))
-    desc, unit = METRIC_INFO[metric]
+    desc, unit = metric_info(metric)
     for ax, t in zip(axes, tiers):
         g = df[df["tier"] == t]
         data, labels = [], []
@@ -174,7 +176,7 @@ def _cell_rows(analysis: Mapping, tier: str, controllers: Sequence[str], tasks: 
         for ctrl in controllers:
             c = cells[(tier, task, ctrl)]
             row = [task, ctrl, f"{c['failures']}/{c['n']} {_ci(*c['failure_ci'], 2)}"]
-            for m in METRICS:
+            for m in analysis["metrics"]:
                 row.append(f"{fmt(c[m]['median'], 3)} {_ci(c[m]['low'], c[m]['high'])}")
             row.append(scores[f"{tier}/{task}"][ctrl]["score"])
             rows.append(row)
@@ -243,6 +245,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
 
     controllers = [e.label for e in entries]
     tiers, tasks = suite.tiers, suite.tasks
+    metrics, primary = analysis["metrics"], suite.file.scoring.primary()
     scores = analysis["scores"]
     order = scores["order"]
     pooled = {r["controller"]: r for r in analysis["pooled"]}
@@ -276,12 +279,21 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
                   "mean over its tasks, the overall score the mean over the tiers. Lower is better. Rank "
                   "interval and P(best): the rule applied to resamples of the seed indices.")
     rep.figure(figure_leaderboard(analysis, tiers), "leaderboard", "Overall and per-tier scores; rank intervals")
+    write_aggregates_section(rep, analysis["aggregates"], order)
 
     rep.heading("Settings")
     rep.table(["setting", "value"], _settings_rows(suite))
     rep.table(["controller", "gains"], [[e.label, e.gains] for e in entries])
     if any("defaults" in e.gains for e in entries):
         rep.paragraph("Controllers without a tuned gain preset run with their package defaults (above).")
+    rep.paragraph("Tuning of each competitor, from its gain preset's provenance (`auvtrack tune` writes it; "
+                  "docs/tuning.md): what it was tuned on, the budget and what it cost.")
+    rep.table(list(TUNING_COLUMNS), tuning_rows(entries))
+    gains = gain_rows(entries)
+    if gains:
+        rep.paragraph("Gains the presets change, next to the published values (the controllers' defaults, "
+                      "docs/controllers.md):")
+        rep.table(["competitor", "gain", "published", "preset", "preset name"], gains)
     rep.table(["task", "duration (s)", "description"],
               [[t, suite.duration(t), suite.file.tasks[t].description] for t in tasks])
     rep.table(["tier", "description"], [[t, suite.file.tiers[t].description] for t in tiers])
@@ -295,6 +307,13 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
         rows.append([r["tier"], r["controller"], f"{r['failures']}/{r['n']}", _pct(r["failure_rate"]),
                      _ci(*r["failure_ci"], 3), causes])
     rep.table(["tier", "controller", "failed", "rate", "Wilson 95 %", "causes"], rows)
+    head, why = failure_cause_rows(analysis["pooled_tier"])
+    if why:
+        rep.paragraph("Why it failed: the failed runs of every tier and controller by cause (pooled over the "
+                      "tasks; `unknown`: a failure without a recorded cause).")
+        rep.table(head, why)
+    else:
+        rep.paragraph("No run failed.")
     setup = df[df["cause"] == "setup"]
     if len(setup):
         rep.paragraph("Runs refused at set-up (counted as failures): " + "; ".join(
@@ -303,29 +322,29 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
     for t in tiers:
         rep.heading(f"Tier `{t}`")
         rep.paragraph(suite.file.tiers[t].description)
-        rep.table(["task", "controller", "failed [Wilson]"] + [f"{m} median [bootstrap]" for m in METRICS]
+        rep.table(["task", "controller", "failed [Wilson]"] + [f"{m} median [bootstrap]" for m in metrics]
                   + ["cell score"], _cell_rows(analysis, t, order, tasks), digits=3)
-        prs = _paired_rows(analysis, t, "rmse", "wilcoxon")
+        prs = _paired_rows(analysis, t, primary, "wilcoxon")
         if prs:
-            rep.paragraph("Paired RMSE comparisons on the same (task, seed) pairs: Wilcoxon signed-rank test; "
+            rep.paragraph(f"Paired `{primary}` comparisons on the same (task, seed) pairs: Wilcoxon signed-rank test; "
                           "effect = rank-biserial correlation of a - b (negative: a smaller); p Holm-adjusted "
                           "over the pairs of this tier. Every criterion and the sign tests: `results.json`.")
             rep.table(["pair", "n", "a < b / a > b / tie", "median a - b", "effect r", "p", "p (Holm)"], prs,
                       digits=3)
 
     rep.heading("Distributions")
-    for m in METRICS:
-        rep.figure(figure_distribution(df, m, tiers, order), f"dist_{m}", f"{m}: {METRIC_INFO[m][0]} "
-                   f"({METRIC_INFO[m][1]})")
+    for m in metrics:
+        desc, unit = metric_info(m)
+        rep.figure(figure_distribution(df, m, tiers, order), f"dist_{m}", f"{m}: {desc} ({unit})")
 
     rep.heading("Representative trajectories")
-    rep.paragraph("Per tier, the seed at the median of the controllers' median RMSE, re-run with its trajectory "
+    rep.paragraph(f"Per tier, the seed at the median of the controllers' median `{primary}`, re-run with its trajectory "
                   "(the same seed for every controller).")
     for task in tasks:
         rep.figure(figure_trajectories(reps, task, tiers, order, seeds), f"traj_{task}", f"{task}")
 
     rep.heading("Metrics")
-    rep.table(["metric", "definition", "unit"], [[m, METRIC_INFO[m][0], METRIC_INFO[m][1]] for m in METRICS])
+    rep.table(["metric", "definition", "unit"], [[m, *metric_info(m)] for m in metrics])
     rep.paragraph("Whole-run metrics of the engine (`docs/metrics.md`) combined over the axes / inputs; "
                   "`inf` = a failed run, or a settling time that never came.")
     rep.heading("Reproduce")
@@ -345,12 +364,12 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
     timing = dict(timing, analysis_seconds=time.perf_counter() - t_analysis0)
     write_json(out / "results.json", {
         "suite": suite.settings(), "controllers": [e.to_dict() for e in entries],
-        "auvtrack_version": __version__, "source_hash": source_hash(), "criteria": list(CRITERIA),
-        "metrics": {m: {"description": METRIC_INFO[m][0], "unit": METRIC_INFO[m][1]} for m in METRICS},
+        "auvtrack_version": __version__, "source_hash": source_hash(), "criteria": list(analysis["criteria"]),
+        "metrics": {m: dict(zip(("description", "unit"), metric_info(m))) for m in metrics},
         "leaderboard": [{"controller": c, **scores["overall"][c], "rank_interval": analysis["rank_intervals"][c],
                          "tiers": {t: scores["tiers"][t][c] for t in tiers}} for c in order],
         "representative_seeds": {f"{k[0]}/{k[1]}": v for k, v in seeds.items()},
-        **{k: analysis[k] for k in ("cells", "pooled_tier", "pooled", "scores", "weights", "paired")},
+        **{k: analysis[k] for k in ("cells", "pooled_tier", "pooled", "scores", "weights", "paired", "aggregates")},
         "timing": timing,
     })
     return report

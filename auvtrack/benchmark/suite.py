@@ -168,7 +168,15 @@ class Tier(_Model):
 
 
 class Scoring(_Model):
-    """``[scoring]``: the weight of each criterion in a cell's score (>= 0, not all 0)."""
+    """``[scoring]``: the weight of each criterion in a cell's score (>= 0, not all 0).
+
+    The fields are the failure rate and the benchmark's derived metrics (:data:`METRICS`, with
+    their defaults); any engine metric (:data:`auvtrack.metrics.METRIC_NAMES`, e.g.
+    ``xtrack_rmse``) can be added by name.  The criteria a suite ranks, tabulates and tests are
+    those with a weight > 0 (:meth:`criteria`).
+    """
+
+    model_config = ConfigDict(extra="allow", frozen=True)
 
     failure: NonNeg = 3.0
     rmse: NonNeg = 1.0
@@ -180,18 +188,39 @@ class Scoring(_Model):
 
     @model_validator(mode="after")
     def _some(self) -> "Scoring":
-        for c in CRITERIA:
-            w = getattr(self, c)
+        from ..metrics import METRIC_NAMES
+
+        for c, w in (self.model_extra or {}).items():
+            if c not in METRIC_NAMES:
+                raise ValueError(f"{c}: not a criterion (failure, one of the benchmark's metrics {', '.join(METRICS)} "
+                                 "or an engine metric, docs/metrics.md)")
+            if isinstance(w, bool) or not isinstance(w, (int, float)) or not math.isfinite(w) or w < 0:
+                raise ValueError(f"{c}: must be a finite number >= 0 (got {w!r})")
+        for c, w in self.weights().items():
             if w != 0 and not MIN_WEIGHT <= w <= MAX_WEIGHT:
                 raise ValueError(f"{c}: must be 0 or in [{MIN_WEIGHT:g}, {MAX_WEIGHT:g}] (only the ratios of the "
                                  f"weights matter) (got {w:g})")
-        if not any(getattr(self, c) > 0 for c in CRITERIA):
+        if not any(w > 0 for w in self.weights().values()):
             raise ValueError("must give at least one criterion a weight > 0")
         return self
 
     def weights(self) -> dict[str, float]:
-        """Criterion -> weight, in :data:`CRITERIA` order."""
-        return {c: float(getattr(self, c)) for c in CRITERIA}
+        """Criterion -> weight: ``failure``, the engine metrics in file order, then :data:`METRICS` in order."""
+        extra = {c: float(w) for c, w in (self.model_extra or {}).items()}
+        return {"failure": float(self.failure)} | extra | {c: float(getattr(self, c)) for c in METRICS}
+
+    def criteria(self) -> tuple[str, ...]:
+        """The criteria with a weight > 0, in :meth:`weights` order (``failure`` first when weighted)."""
+        return tuple(c for c, w in self.weights().items() if w > 0)
+
+    def metrics(self) -> tuple[str, ...]:
+        """The weighted criteria other than the failure rate: the metrics whose medians are ranked."""
+        return tuple(c for c in self.criteria() if c != "failure")
+
+    def primary(self) -> str:
+        """The metric with the largest weight (the first in :meth:`weights` order on a tie)."""
+        w = self.weights()
+        return max(self.metrics(), key=lambda c: w[c], default="rmse")
 
 
 class RunScore(_Model):
