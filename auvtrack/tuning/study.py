@@ -12,14 +12,15 @@ first batch holding a failure.  The objective is :mod:`auvtrack.tuning.objective
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Iterator, Mapping
 
 from .objective import candidate_table, evaluate, split_specs
-from .space import constraint_violations, distributions, search_space
+from .space import Dimension, constraint_violations, distributions, search_space
 
 __all__ = ["SAMPLERS", "STUDY_NAME", "TrialJob", "TuneResult", "add_trials", "controller_base", "trial_seed", "tune"]
 
@@ -180,6 +181,37 @@ def load_study(url: str, sampler: str, seed: int):
     return optuna.load_study(study_name=STUDY_NAME, storage=_storage(url), sampler=_sampler(sampler, seed))
 
 
+@contextlib.contextmanager
+def asking(url: str) -> Iterator[None]:
+    """Hold the study's ask lock (``study.db.lock``, an exclusive ``flock``) while trials are asked.
+
+    Python's SQLite driver reads outside its write transactions, so two workers asking at once
+    could both take the same waiting (enqueued) trial; asks, the budget check and the hand-back
+    of interrupted trials go one at a time instead.  Without ``fcntl`` (not POSIX) nothing is locked.
+
+    Parameters
+    ----------
+    url : str
+        The study's ``sqlite:///`` URL.
+
+    Yields
+    ------
+    None
+        With the lock held.
+    """
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    with open(url.removeprefix("sqlite:///") + ".lock", "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
 def _owner() -> str:
     import os
     import socket
@@ -284,6 +316,36 @@ class TrialJob:
     workers: int | None = 1
     backend: str | None = None
     chunk: int | None = None
+
+
+def untuned_gains(spec, space: Mapping[str, Dimension]) -> dict[str, float]:
+    """The gains a run flies without tuning (the defaults as the scenario resolves them for its vehicle), in the space.
+
+    Parameters
+    ----------
+    spec : RunSpec
+        A run of the split with the bare ``[controller]`` table.
+    space : mapping of str to Dimension
+        The search space (a value outside it is clipped to its range).
+
+    Returns
+    -------
+    dict of str to float
+        One value per tunable gain.
+    """
+    from ..scenario import load_scenario
+
+    section = load_scenario(spec.raw, spec.overrides).controller
+    values = getattr(section, "params", None) if getattr(section, "kind", "") == "plugin" else None
+    get = (lambda k: values[k]) if isinstance(values, Mapping) else (lambda k: getattr(section, k))
+    out = {}
+    for k, d in space.items():
+        try:
+            v = float(get(k))
+        except (AttributeError, KeyError, TypeError):
+            v = d.default
+        out[k] = min(max(v, d.low), d.high)
+    return out
 
 
 def trial_seed(seed: int, worker: int, finished: int) -> int:
@@ -397,20 +459,22 @@ def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
     dists = distributions(search_space(_params_model(job.base)))
     cost = {"runs": 0, "steps": 0, "cpu_s": 0.0}
     while len(finished_trials(study)) + len(_running(study)) < job.trials:
-        study.sampler = _sampler(job.sampler, trial_seed(job.seed, worker, len(finished_trials(study))))
-        trial = study.ask(dists)
-        trial.set_user_attr("owner", _owner())
-        ahead = [t for t in study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.PRUNED,
-                                                                    TrialState.RUNNING)) if t.number < trial.number]
-        if len(ahead) >= job.trials:  # another worker asked the last trial of the budget first
-            trial.set_user_attr("surplus", True)
-            study.tell(trial, state=TrialState.FAIL)
-            break
+        with asking(job.study):
+            study.sampler = _sampler(job.sampler, trial_seed(job.seed, worker, len(finished_trials(study))))
+            trial = study.ask(dists)
+            trial.set_user_attr("owner", _owner())
+            ahead = [t for t in study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.PRUNED,
+                                                                        TrialState.RUNNING)) if t.number < trial.number]
+            if len(ahead) >= job.trials:  # another worker asked the last trial of the budget first
+                trial.set_user_attr("surplus", True)
+                study.tell(trial, state=TrialState.FAIL)
+                break
         c0 = time.process_time()
         try:
             _fly(study, trial, job, st, cost)
         except BaseException:  # a stop: the trial's gains are asked again when the tuning resumes
-            _give_back(study, trial)
+            with asking(job.study):
+                _give_back(study, trial)
             raise
         cost["cpu_s"] += time.process_time() - c0
         if progress is not None:
@@ -493,7 +557,10 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
     study, url = _open_study(out, sampler, seed)
     study.set_user_attr("controller", base)
     study.set_user_attr("suite", f"{st.name} v{st.file.version}")
-    _requeue_interrupted(study)
+    with asking(url):
+        _requeue_interrupted(study)
+        if not study.get_trials(deepcopy=False):  # the first candidate: the gains flown without tuning
+            study.enqueue_trial(untuned_gains(probe[0], space), user_attrs={"first_candidate": "untuned"})
     suite_ref = str(Path(suite).resolve()) if Path(str(suite)).suffix == ".toml" else str(suite)
     job = TrialJob(base, suite_ref, split, trials, url, sampler, seed, workers, backend, chunk)
     res = TuneResult(controller=base, suite=f"{st.name} v{st.file.version}", split=split, study=url)
