@@ -319,7 +319,11 @@ class TrialJob:
 
 
 def untuned_gains(spec, space: Mapping[str, Dimension]) -> dict[str, float]:
-    """The gains a run flies without tuning (the defaults as the scenario resolves them for its vehicle), in the space.
+    """The tunable gains a bare ``[controller]`` table resolves to for the run's vehicle, in the space.
+
+    A candidate holding them is flown with the law's defaults for its other fields (a table with
+    gains given is not designed, :mod:`auvtrack.scenario.designed`), e.g. the published
+    saturation form where the bare table gets the compensated one.
 
     Parameters
     ----------
@@ -559,7 +563,7 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
     study.set_user_attr("suite", f"{st.name} v{st.file.version}")
     with asking(url):
         _requeue_interrupted(study)
-        if not study.get_trials(deepcopy=False):  # the first candidate: the gains flown without tuning
+        if not study.get_trials(deepcopy=False):  # the first candidate: the untuned (designed) gains
             study.enqueue_trial(untuned_gains(probe[0], space), user_attrs={"first_candidate": "untuned"})
     suite_ref = str(Path(suite).resolve()) if Path(str(suite)).suffix == ".toml" else str(suite)
     job = TrialJob(base, suite_ref, split, trials, url, sampler, seed, workers, backend, chunk)
