@@ -81,3 +81,17 @@ def test_the_shared_budget_is_the_suite_presets_trials(tiny, tmp_path, monkeypat
     _preset(tmp_path, "ftsmc_remus100_tiny", "tiny v1", 5)
     with pytest.raises(ValueError, match="different budgets"):
         shared_budget(suite)
+
+
+@pytest.mark.parametrize("name", ["auv-track-v1", "auv-track-v2"])
+def test_every_shipped_suite_with_tuned_presets_has_one_shared_budget(name):
+    from auvtrack.benchmark.suite import tracking_kinds
+
+    suite = load_suite(name, check=False)
+    trials = shared_budget(suite)  # refuses presets of one suite tuned at different budgets
+    shipped = [k for k in tracking_kinds() if f"{k}_remus100_{name}" in gain_presets.available_gain_presets()]
+    assert trials >= 1 and shipped
+    for k in shipped:
+        preset = gain_presets.get_gain_preset(f"{k}_remus100_{name}")
+        assert preset.kind == k and preset.provenance["split"] == "training"
+        assert preset.provenance["budget_runs"] == trials * preset.provenance["runs_per_trial"]
