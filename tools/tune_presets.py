@@ -28,12 +28,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sampler", default="tpe")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--controllers", default=",".join(tracking_kinds()))
-    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--workers", type=int, default=1, help="threads of the batch runner inside a trial")
+    ap.add_argument("--parallel", type=int, default=1, help="trials flown at once (local processes)")
     ap.add_argument("--install", action="store_true", help="copy each preset into auvtrack/data/gains/")
     a = ap.parse_args(argv)
     for kind in [k for k in a.controllers.split(",") if k]:
         res = tune(kind, a.suite, trials=a.budget, out=Path(a.out) / kind, sampler=a.sampler, seed=a.seed,
-                   workers=a.workers)
+                   workers=a.workers, parallel=a.parallel)
         print(f"{kind}: {res.trials} trials ({res.complete} complete, {res.pruned} pruned, {res.refused} refused), "
               f"{res.runs} runs, {res.steps} steps, {res.cpu_s:.0f} CPU s, {res.wall_s:.0f} s; "
               f"train {res.best_score:.4g}, validation {res.validation_score:.4g}", flush=True)

@@ -19,7 +19,7 @@ def _split_names(values: tuple[str, ...]) -> list[str]:
 
 def resume_command(suite_name: str, quick: bool, controllers: list[str] | None, plugins: tuple[str, ...],
                    folder: Path, backend: str | None, scheduler: str | None, workers: int | None,
-                   max_runs: int | None) -> str:
+                   max_runs: int | None, tune: str | None = None) -> str:
     """The command that finishes a comparison: every option that defines it, ``--out`` and ``--resume``.
 
     Parameters
@@ -38,6 +38,8 @@ def resume_command(suite_name: str, quick: bool, controllers: list[str] | None, 
         ``--backend`` (part of the comparison's fingerprint) and ``--scheduler``, when given.
     workers, max_runs : int or None
         ``--workers`` and ``--max-runs``, when given.
+    tune : str or None, optional
+        ``--tune`` (``"suite"`` for the flag without a value), when given.
 
     Returns
     -------
@@ -59,6 +61,8 @@ def resume_command(suite_name: str, quick: bool, controllers: list[str] | None, 
         args += ["--workers", str(workers)]
     if max_runs is not None:
         args += ["--max-runs", str(max_runs)]
+    if tune is not None:
+        args += ["--tune"] if tune == "suite" else ["--tune", tune]
     return shlex.join([*args, "--out", str(folder), "--resume"])
 
 
@@ -87,9 +91,12 @@ def resume_command(suite_name: str, quick: bool, controllers: list[str] | None, 
               "(fingerprint, content hash) and kept; bad ones are named and recomputed.")
 @click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("--tune", "tune_budget", is_flag=False, flag_value="suite", default=None, metavar="[TRIALS]",
+              help="Tune each --plugin first (auvtrack tune on the suite's training split, in <out>-tune/) at the "
+                   "suite's shared budget (its presets' trials) or TRIALS; it enters with its best gains.")
 def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, ...], quick: bool, out: str | None,
             scheduler: str | None, workers: int | None, backend: str | None, max_runs: int | None, resume: bool,
-            max_chunks: int | None, quiet: bool) -> None:
+            max_chunks: int | None, quiet: bool, tune_budget: str | None) -> None:
     """Benchmark the controllers over a suite's tasks x tiers x seeds; write report.md/.html, results.json, runs.parquet.
 
     Every registered tracking controller runs with its tuned gain preset ({kind}_tuned) or, without one, its
@@ -115,10 +122,20 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
     if quick:
         suite = suite.quick_variant()
     folder = Path(out) if out else default_out(suite)
-    again = resume_command(suite_name, quick, names, plugins, folder, backend, scheduler, workers, max_runs)
+    again = resume_command(suite_name, quick, names, plugins, folder, backend, scheduler, workers, max_runs,
+                           tune_budget)
     with stop_once():  # Ctrl-C or SIGTERM: stop once, the finished chunks stay for --resume
         try:
+            entries = None
+            if tune_budget is not None:
+                from ..tuning.newcomer import tuned_entries
+
+                try:
+                    entries = tuned_entries(suite, names, plugins, tune_budget, folder, progress=click.echo)
+                except ValueError as exc:  # one line naming --tune (a SuiteError is one too)
+                    raise BadInput(one_line(exc)) from None
             res = _compare(suite, controllers=names, plugins=list(plugins), out=folder, scheduler=scheduler,
+                           entries=entries,
                            workers=workers, backend=backend, resume=resume, max_chunks=max_chunks,
                            max_runs=DEFAULT_MAX_RUNS if max_runs is None else max_runs, progress=not quiet)
         except (SuiteError, CompareError) as exc:

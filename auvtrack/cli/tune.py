@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import click
 
+from ..batch.scheduler import SCHEDULER_TIMEOUT_S
 from .common import EXIT_CODES_HELP, EXIT_INTERRUPTED, BadInput, cli, one_line
 from .signals import stop_once
 
@@ -20,11 +21,17 @@ from .signals import stop_once
 @click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed.")
 @click.option("--workers", type=click.IntRange(1, 256), default=1, show_default=True,
               help="Threads of the batch runner inside a trial.")
+@click.option("--parallel", type=click.IntRange(1, 256), default=1, show_default=True,
+              help="Trials flown at once by local processes adding to the one study (with --scheduler: Dask tasks, "
+                   "default one per thread of the cluster).")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help=f"Add the trials on an existing Dask scheduler, tcp://host:port (probed for {SCHEDULER_TIMEOUT_S:g} s "
+                   "first); its workers must reach --out.")
 @click.option("--backend", default=None, metavar="NAME", help="Back end of the batch runner.")
 @click.option("--no-validate", is_flag=True, help="Do not fly the best gains on the validation split.")
 @click.option("--quiet", is_flag=True, help="No progress line.")
 def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, seed: int, workers: int,
-         backend: str | None, no_validate: bool, quiet: bool) -> None:
+         parallel: int, scheduler: str | None, backend: str | None, no_validate: bool, quiet: bool) -> None:
     """Tune a controller for the suite's vehicle with Optuna; Ctrl-C keeps the study, run again to resume."""
     from ..benchmark.suite import SuiteError
     from ..tuning import tune as _tune
@@ -36,7 +43,8 @@ def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, 
     with stop_once():
         try:
             res = _tune(controller, suite_name, trials=budget, out=out, sampler=sampler, seed=seed,
-                        validate=not no_validate, workers=workers, backend=backend, progress=progress)
+                        validate=not no_validate, workers=workers, backend=backend, parallel=parallel,
+                        scheduler=scheduler, progress=progress)
         except (SuiteError, ValueError) as exc:
             raise BadInput(one_line(exc)) from None
         except KeyboardInterrupt:

@@ -115,6 +115,8 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
     provenance = {"tool": "auvtrack tune", "suite": res.suite, "split": res.split,
                   "budget_trials": res.trials, "runs_per_trial": runs_per_trial,
                   "budget_runs": res.trials * runs_per_trial, "sampler": sampler, "sampler_seed": seed,
+                  "first_candidate": next((t["user_attrs"].get("first_candidate", "sampled") for t in trials
+                                           if t["number"] == 0), "sampled"),
                   "optuna": optuna.__version__, "auvtrack": __version__, "source_hash": source_hash()[:16],
                   "train_score": res.best_score, "validation_score": res.validation_score,
                   "complete": res.complete, "pruned": res.pruned, "refused": res.refused,

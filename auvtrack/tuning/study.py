@@ -12,16 +12,17 @@ first batch holding a failure.  The objective is :mod:`auvtrack.tuning.objective
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Iterator, Mapping
 
 from .objective import candidate_table, evaluate, split_specs
-from .space import constraint_violations, distributions, search_space
+from .space import Dimension, constraint_violations, distributions, search_space
 
-__all__ = ["SAMPLERS", "STUDY_NAME", "TuneResult", "tune", "controller_base"]
+__all__ = ["SAMPLERS", "STUDY_NAME", "TrialJob", "TuneResult", "add_trials", "controller_base", "trial_seed", "tune"]
 
 SAMPLERS = ("tpe", "cmaes")
 STUDY_NAME = "tune"
@@ -137,14 +138,78 @@ def _sampler(name: str, seed: int):
     raise ValueError(f"--sampler: must be one of {', '.join(SAMPLERS)} (got {name!r})")
 
 
+SQLITE_TIMEOUT_S = 120.0
+"""Seconds a process waits for another's write lock on ``study.db`` before giving up."""
+
+
+def _storage(url: str):
+    import optuna
+
+    return optuna.storages.RDBStorage(url, engine_kwargs={"connect_args": {"timeout": SQLITE_TIMEOUT_S}})
+
+
 def _open_study(out: Path, sampler: str, seed: int):
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     url = f"sqlite:///{(out / STUDY_FILE).resolve()}"
-    study = optuna.create_study(study_name=STUDY_NAME, storage=url, direction="minimize", load_if_exists=True,
-                                sampler=_sampler(sampler, seed))
+    study = optuna.create_study(study_name=STUDY_NAME, storage=_storage(url), direction="minimize",
+                                load_if_exists=True, sampler=_sampler(sampler, seed))
     return study, url
+
+
+def load_study(url: str, sampler: str, seed: int):
+    """The tuning's Optuna study at ``url`` with a fresh sampler (a lock wait of :data:`SQLITE_TIMEOUT_S`).
+
+    Parameters
+    ----------
+    url : str
+        SQLite storage URL.
+    sampler : str
+        ``tpe`` or ``cmaes``.
+    seed : int
+        The sampler's seed.
+
+    Returns
+    -------
+    optuna.Study
+        The study.
+    """
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    return optuna.load_study(study_name=STUDY_NAME, storage=_storage(url), sampler=_sampler(sampler, seed))
+
+
+@contextlib.contextmanager
+def asking(url: str) -> Iterator[None]:
+    """Hold the study's ask lock (``study.db.lock``, an exclusive ``flock``) while trials are asked.
+
+    Python's SQLite driver reads outside its write transactions, so two workers asking at once
+    could both take the same waiting (enqueued) trial; asks, the budget check and the hand-back
+    of interrupted trials go one at a time instead.  Without ``fcntl`` (not POSIX) nothing is locked.
+
+    Parameters
+    ----------
+    url : str
+        The study's ``sqlite:///`` URL.
+
+    Yields
+    ------
+    None
+        With the lock held.
+    """
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    with open(url.removeprefix("sqlite:///") + ".lock", "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def _owner() -> str:
@@ -182,20 +247,249 @@ def _requeue_interrupted(study) -> None:
     for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
         if _alive(str(t.user_attrs.get("owner", ""))):
             continue
-        study._storage.set_trial_state_values(t._trial_id, TrialState.FAIL)
-        study.enqueue_trial(t.params, user_attrs={"requeued_from": t.number}, skip_if_exists=False)
+        _give_back(study, t)
 
 
-def _finished(study) -> list:
+def _give_back(study, trial) -> None:
+    """Fail an interrupted trial and ask its gains again first (nothing lost, nothing counted twice)."""
+    from optuna.trial import TrialState
+
+    if study._storage.get_trial(trial._trial_id).state != TrialState.RUNNING:
+        return  # already told
+    study._storage.set_trial_state_values(trial._trial_id, TrialState.FAIL)
+    study.enqueue_trial(trial.params, user_attrs={"requeued_from": trial.number}, skip_if_exists=False)
+
+
+def finished_trials(study) -> list:
+    """The study's finished trials (complete, pruned, refused), the ones the budget counts.
+
+    Parameters
+    ----------
+    study : optuna.Study
+        The study.
+
+    Returns
+    -------
+    list of optuna.trial.FrozenTrial
+        Complete and pruned trials (a refused candidate is a complete trial with violations).
+    """
     from optuna.trial import TrialState
 
     return study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.PRUNED))
 
 
+@dataclass(frozen=True)
+class TrialJob:
+    """What a process or a Dask worker needs to add trials to a tuning's study (picklable).
+
+    Attributes
+    ----------
+    base : dict
+        The ``[controller]`` table tuned.
+    suite : str
+        Suite name or absolute file path.
+    split : str
+        The split flown.
+    trials : int
+        Finished trials the study is to hold.
+    study : str
+        The Optuna storage URL (SQLite file of the output folder).
+    sampler : str
+        ``tpe`` or ``cmaes``.
+    seed : int
+        Sampler seed.
+    workers : int or None
+        Threads of the batch runner inside a trial.
+    backend : str or None
+        Back end of the batch runner.
+    chunk : int or None
+        Runs per batch inside a trial (default one (task, tier) cell).
+    """
+
+    base: dict
+    suite: str
+    split: str
+    trials: int
+    study: str
+    sampler: str
+    seed: int
+    workers: int | None = 1
+    backend: str | None = None
+    chunk: int | None = None
+
+
+def untuned_gains(spec, space: Mapping[str, Dimension]) -> dict[str, float]:
+    """The tunable gains a bare ``[controller]`` table resolves to for the run's vehicle, in the space.
+
+    A candidate holding them is flown with the law's defaults for its other fields (a table with
+    gains given is not designed, :mod:`auvtrack.scenario.designed`), e.g. the published
+    saturation form where the bare table gets the compensated one.
+
+    Parameters
+    ----------
+    spec : RunSpec
+        A run of the split with the bare ``[controller]`` table.
+    space : mapping of str to Dimension
+        The search space (a value outside it is clipped to its range).
+
+    Returns
+    -------
+    dict of str to float
+        One value per tunable gain.
+    """
+    from ..scenario import load_scenario
+
+    section = load_scenario(spec.raw, spec.overrides).controller
+    values = getattr(section, "params", None) if getattr(section, "kind", "") == "plugin" else None
+    get = (lambda k: values[k]) if isinstance(values, Mapping) else (lambda k: getattr(section, k))
+    out = {}
+    for k, d in space.items():
+        try:
+            v = float(get(k))
+        except (AttributeError, KeyError, TypeError):
+            v = d.default
+        out[k] = min(max(v, d.low), d.high)
+    return out
+
+
+def trial_seed(seed: int, worker: int, finished: int) -> int:
+    """The sampler seed of the next trial a worker asks.
+
+    Worker 0 uses ``seed + finished`` (with one worker the sequence of trials is a function of
+    the seed and the history); another worker draws its seed from ``SeedSequence([seed, worker,
+    finished])``, so two workers never sample from the same stream.
+
+    Parameters
+    ----------
+    seed : int
+        The tuning's sampler seed.
+    worker : int
+        Index of the process or Dask task adding trials (0 for a single process).
+    finished : int
+        Trials finished in the study when the trial is asked.
+
+    Returns
+    -------
+    int
+        A seed in [0, 2**32).
+    """
+    if worker == 0:
+        return seed + finished
+    import numpy as np
+
+    return int(np.random.SeedSequence([seed, worker, finished]).generate_state(1)[0])
+
+
+def _running(study) -> list:
+    from optuna.trial import TrialState
+
+    return study.get_trials(deepcopy=False, states=(TrialState.RUNNING,))
+
+
+def _fly(study, trial, job: TrialJob, st, cost: dict) -> None:
+    """Fly one asked trial on the split (or refuse it on a set-up condition) and tell the study."""
+    import optuna
+
+    from ..scenario import load_scenario
+
+    w0, c0 = time.perf_counter(), time.process_time()
+    gains = dict(trial.params)
+    table = candidate_table(job.base, gains)
+    specs = split_specs(st, table, job.split)
+    problems = constraint_violations(load_scenario(specs[0].raw, specs[0].overrides))
+    if problems:
+        # scored as the benchmark scores a refused set-up: every run failed at t = 0
+        trial.set_user_attr("violations", len(problems))
+        trial.set_user_attr("constraint", problems)
+        if job.sampler == "tpe":  # CMA-ES has no constraint handling: it sees the failure score only
+            trial.set_constraint("setup", float(len(problems)))
+        study.tell(trial, st.file.run_score.cap + 2.0)
+    else:
+        trial.set_user_attr("violations", 0)
+        if job.sampler == "tpe":
+            trial.set_constraint("setup", 0.0)
+
+        def report(ev, trial=trial):
+            trial.report(ev.score, ev.runs)
+
+        per_cell = max(len(st.split_seeds(job.split)), 1)
+        ev = evaluate(st, specs, chunk=job.chunk or per_cell, stop_on_failure=True, workers=job.workers,
+                      backend=job.backend, on_chunk=report)
+        cost["runs"] += ev.runs
+        cost["steps"] += ev.steps
+        trial.set_user_attr("runs", ev.runs)
+        trial.set_user_attr("steps", ev.steps)
+        trial.set_user_attr("failed_runs", ev.failed)
+        first = next((r for r in ev.rows if r["status"] != "ok"), None)
+        if first is not None:  # why the candidate failed: the mechanism, for the report
+            trial.set_user_attr("first_failure", {k: first[k] for k in ("task", "tier", "seed_index", "cause",
+                                                                         "detail", "t_stop")})
+        trial.set_user_attr("wall_s", time.perf_counter() - w0)
+        trial.set_user_attr("cpu_s", time.process_time() - c0)
+        if ev.stopped_early:
+            study.tell(trial, state=optuna.trial.TrialState.PRUNED)
+        else:
+            study.tell(trial, ev.score)
+
+
+def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
+    """Ask, fly and tell trials until the study holds ``job.trials`` finished ones (counting those running).
+
+    Several processes or Dask tasks may call this on one study at once (each with its own
+    ``worker`` index): a trial asked when the trials finished or running before it already reach
+    the budget is told ``FAIL`` with the user attribute ``surplus`` and not flown, so the study
+    ends with exactly ``job.trials`` finished trials.
+
+    Parameters
+    ----------
+    job : TrialJob
+        The tuning.
+    worker : int, optional
+        This worker's index (its sampler seeds, :func:`trial_seed`).
+    progress : callable, optional
+        ``progress(done, total)`` after each trial.
+
+    Returns
+    -------
+    dict
+        ``runs``, ``steps`` and ``cpu_s`` this worker spent.
+    """
+    from optuna.trial import TrialState
+
+    from ..benchmark.suite import load_suite
+
+    st = load_suite(job.suite)
+    study = load_study(job.study, job.sampler, job.seed)
+    dists = distributions(search_space(_params_model(job.base)))
+    cost = {"runs": 0, "steps": 0, "cpu_s": 0.0}
+    while len(finished_trials(study)) + len(_running(study)) < job.trials:
+        with asking(job.study):
+            study.sampler = _sampler(job.sampler, trial_seed(job.seed, worker, len(finished_trials(study))))
+            trial = study.ask(dists)
+            trial.set_user_attr("owner", _owner())
+            ahead = [t for t in study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.PRUNED,
+                                                                        TrialState.RUNNING)) if t.number < trial.number]
+            if len(ahead) >= job.trials:  # another worker asked the last trial of the budget first
+                trial.set_user_attr("surplus", True)
+                study.tell(trial, state=TrialState.FAIL)
+                break
+        c0 = time.process_time()
+        try:
+            _fly(study, trial, job, st, cost)
+        except BaseException:  # a stop: the trial's gains are asked again when the tuning resumes
+            with asking(job.study):
+                _give_back(study, trial)
+            raise
+        cost["cpu_s"] += time.process_time() - c0
+        if progress is not None:
+            progress(len(finished_trials(study)), job.trials)
+    return cost
+
+
 def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, out: str | Path,
          sampler: str = "tpe", seed: int = 0, split: str = "training", validate: bool = True,
          workers: int | None = 1, backend: str | None = None, chunk: int | None = None,
-         progress=None) -> TuneResult:
+         parallel: int = 1, scheduler: str | None = None, client: Any = None, progress=None) -> TuneResult:
     """Tune one controller's declared gains on a suite's split; resumes the study found in ``out``.
 
     Parameters
@@ -223,8 +517,15 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
     chunk : int, optional
         Runs per batch inside a trial (a failing candidate is pruned after the first batch
         holding a failure; default: one (task, tier) cell).
+    parallel : int, optional
+        Trials flown at once: local processes adding trials to the study (1: this process);
+        on Dask, the number of tasks (default there: the cluster's threads).
+    scheduler : str, optional
+        Address of a Dask scheduler whose workers add the trials (they must reach ``out``).
+    client : distributed.Client, optional
+        An existing Dask client (overrides ``scheduler``; left open).
     progress : callable, optional
-        ``progress(done, total)`` after each trial.
+        ``progress(done, total)`` after each trial (in this process only).
 
     Returns
     -------
@@ -234,78 +535,49 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
     Raises
     ------
     ValueError
-        One line: bad controller, sampler, split or trials; a controller declaring no tunable gain.
+        One line: bad controller, sampler, split, trials or parallel; a controller declaring no
+        tunable gain; a scheduler that does not answer.
     """
-    import optuna
-
     from ..benchmark.suite import load_suite
+    from .parallel import run_workers
 
     if isinstance(trials, bool) or not isinstance(trials, int) or trials < 1:
         raise ValueError(f"--budget: must be a number of trials >= 1 (got {trials!r})")
+    if isinstance(parallel, bool) or not isinstance(parallel, int) or not 1 <= parallel <= 256:
+        raise ValueError(f"--parallel: must be an integer in [1, 256] (got {parallel!r})")
     base = controller_base(controller)
     space = search_space(_params_model(base))
     if not space:
         raise ValueError(f"controller: {controller} declares no tunable gain (tunable(...) on its Params fields)")
+    _sampler(sampler, seed)  # refuses an unknown sampler before anything is stored
+    if scheduler and client is None:
+        from ..batch.scheduler import probe_scheduler
+
+        probe_scheduler(scheduler)  # one line, before anything is stored
     st = load_suite(suite)
     probe = split_specs(st, base, split)  # refuses the evaluation split before anything is stored
-    per_cell = max(len(st.split_seeds(split)), 1)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     study, url = _open_study(out, sampler, seed)
     study.set_user_attr("controller", base)
     study.set_user_attr("suite", f"{st.name} v{st.file.version}")
-    _requeue_interrupted(study)
-    dists = distributions(space)
-    cap = st.file.run_score.cap
+    with asking(url):
+        _requeue_interrupted(study)
+        if not study.get_trials(deepcopy=False):  # the first candidate: the untuned (designed) gains
+            study.enqueue_trial(untuned_gains(probe[0], space), user_attrs={"first_candidate": "untuned"})
+    suite_ref = str(Path(suite).resolve()) if Path(str(suite)).suffix == ".toml" else str(suite)
+    job = TrialJob(base, suite_ref, split, trials, url, sampler, seed, workers, backend, chunk)
     res = TuneResult(controller=base, suite=f"{st.name} v{st.file.version}", split=split, study=url)
     t_wall, t_cpu = time.perf_counter(), time.process_time()
-    while len(_finished(study)) < trials:
-        study.sampler = _sampler(sampler, seed + len(_finished(study)))
-        trial = study.ask(dists)
-        trial.set_user_attr("owner", _owner())
-        w0, c0 = time.perf_counter(), time.process_time()
-        gains = dict(trial.params)
-        table = candidate_table(base, gains)
-        specs = split_specs(st, table, split)
-        from ..scenario import load_scenario
-
-        problems = constraint_violations(load_scenario(specs[0].raw, specs[0].overrides))
-        if problems:
-            # scored as the benchmark scores a refused set-up: every run failed at t = 0
-            trial.set_user_attr("violations", len(problems))
-            trial.set_user_attr("constraint", problems)
-            if sampler == "tpe":  # CMA-ES has no constraint handling: it sees the failure score only
-                trial.set_constraint("setup", float(len(problems)))
-            study.tell(trial, cap + 2.0)
-        else:
-            trial.set_user_attr("violations", 0)
-            if sampler == "tpe":
-                trial.set_constraint("setup", 0.0)
-
-            def report(ev, trial=trial):
-                trial.report(ev.score, ev.runs)
-
-            ev = evaluate(st, specs, chunk=chunk or per_cell, stop_on_failure=True, workers=workers,
-                          backend=backend, on_chunk=report)
-            res.runs += ev.runs
-            res.steps += ev.steps
-            trial.set_user_attr("runs", ev.runs)
-            trial.set_user_attr("steps", ev.steps)
-            trial.set_user_attr("failed_runs", ev.failed)
-            first = next((r for r in ev.rows if r["status"] != "ok"), None)
-            if first is not None:  # why the candidate failed: the mechanism, for the report
-                trial.set_user_attr("first_failure", {k: first[k] for k in ("task", "tier", "seed_index", "cause",
-                                                                             "detail", "t_stop")})
-            trial.set_user_attr("wall_s", time.perf_counter() - w0)
-            trial.set_user_attr("cpu_s", time.process_time() - c0)
-            if ev.stopped_early:
-                study.tell(trial, state=optuna.trial.TrialState.PRUNED)
-            else:
-                study.tell(trial, ev.score)
-        if progress is not None:
-            progress(len(_finished(study)), trials)
-    res.wall_s, res.cpu_s = time.perf_counter() - t_wall, time.process_time() - t_cpu
-    _summarise(study, res)
+    if parallel == 1 and scheduler is None and client is None:
+        costs = [add_trials(job, 0, progress)]
+    else:
+        costs = run_workers(job, parallel=parallel, scheduler=scheduler, client=client, progress=progress)
+    res.runs = sum(c["runs"] for c in costs)
+    res.steps = sum(c["steps"] for c in costs)
+    res.wall_s = time.perf_counter() - t_wall
+    res.cpu_s = time.process_time() - t_cpu if len(costs) == 1 and parallel == 1 else sum(c["cpu_s"] for c in costs)
+    _summarise(load_study(url, sampler, seed), res)
     if validate and res.best_params and st.file.splits.validation is not None:
         ev = evaluate(st, split_specs(st, candidate_table(base, res.best_params), "validation"),
                       workers=workers, backend=backend)
@@ -324,7 +596,7 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
 def _summarise(study, res: TuneResult) -> None:
     from optuna.trial import TrialState
 
-    done = _finished(study)
+    done = finished_trials(study)
     res.trials = len(done)
     res.complete = sum(t.state == TrialState.COMPLETE and not t.user_attrs.get("violations") for t in done)
     res.refused = sum(bool(t.user_attrs.get("violations")) for t in done)

@@ -51,8 +51,11 @@ def test_the_preset_is_usable_as_controller_preset(tuned, monkeypatch):
 @pytest.mark.parametrize("args, field", [
     (["--controller", "open_loop", "--budget", "2"], "controller:"),
     (["--controller", "pid", "--budget", "0"], "--budget:"),
+    (["--controller", "pid", "--budget", "2", "--scheduler", "tcp://127.0.0.1:1"], "--scheduler:"),
+    (["--controller", "pid", "--budget", "2", "--parallel", "0"], "--parallel"),
 ])
 def test_bad_input_is_one_line(tuned, tmp_path, args, field):
     root, _ = tuned
     r = CliRunner().invoke(cli, ["tune", "--suite", str(root / "tiny.toml"), "--out", str(tmp_path / "x"), *args])
     assert r.exit_code == 2 and field in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "x").exists()  # refused before anything is stored

@@ -10,7 +10,7 @@ from auvtrack.benchmark.leaderboard import derive_metrics
 from auvtrack.benchmark.suite import available_suites, load_suite
 from auvtrack.tuning import tune
 from auvtrack.tuning import study as study_mod
-from auvtrack.tuning.objective import candidate_table, split_specs
+from auvtrack.tuning.objective import candidate_table, evaluate, split_specs
 from tiny_suite import TINY
 
 from tuning_suite import SPLITS
@@ -42,6 +42,15 @@ def test_trial_value_is_the_benchmark_score_of_its_runs(suite_path, tmp_path):
     scores = [st.run_score(r, r["task"]) for r in df.to_dict("records")]
     assert value == pytest.approx(math.fsum(scores) / len(scores), rel=0, abs=0)
     assert math.isfinite(res.validation_score)
+
+
+def test_the_first_candidate_holds_the_untuned_gains(suite_path, tmp_path):
+    # the tiny suite sets no actuator limit, so the saturation form a bare table gets does not matter here
+    res = tune("pid", suite_path, trials=1, out=tmp_path / "d0", validate=False)
+    (state, params, value), = _trials(tmp_path / "d0")
+    st = load_suite(suite_path)
+    assert value == evaluate(st, split_specs(st, {"kind": "pid"}, "training")).score  # the gains flown untuned
+    assert res.best_params == params
 
 
 def test_tuning_refuses_the_evaluation_split(suite_path):
