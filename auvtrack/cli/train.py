@@ -38,7 +38,8 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
     every completed iteration, run again to resume.
     """
     from ..benchmark.suite import SuiteError
-    from ..gym.train import TrainConfig, train as _train
+    from ..gym.train import TrainConfig
+    from ..gym.train import train as _train
 
     cfg = TrainConfig(suite=suite_name, tier=tier, tasks=tuple(tasks),
                       iterations=iterations if iterations is not None else (QUICK_ITERATIONS if quick else ITERATIONS),

@@ -24,9 +24,9 @@ import json
 import math
 import platform
 import time
-from dataclasses import asdict, dataclass, field, replace
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -37,7 +37,7 @@ from ..control.policy_observation import OBS
 from .env import suite_of
 from .vector import TrackVectorEnv
 
-__all__ = ["TrainConfig", "TrainResult", "train", "rollout", "command_line", "METHOD"]
+__all__ = ["METHOD", "TrainConfig", "TrainResult", "command_line", "rollout", "train"]
 
 METHOD = "ARS V2-t (Mania, Guy and Recht 2018, Algorithm 2)"
 CHECKPOINT = "checkpoint.npz"
@@ -265,7 +265,7 @@ class _Trainer:
     def validation_return(self, M: np.ndarray, mean: np.ndarray, std: np.ndarray) -> float:
         """Mean held-out return of policy M over the validation seeds and the tasks."""
         rets = []
-        for t, venv in self.val_envs.items():
+        for venv in self.val_envs.values():
             r, _ = rollout(venv, self.val_seeds, np.repeat(M[None], venv.num_envs, 0), mean, std)
             rets.append(r)
         return float(np.mean(np.concatenate(rets)))
@@ -456,20 +456,3 @@ def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None]
         finish()
     return res
 
-
-def with_budget(cfg: TrainConfig, iterations: int) -> TrainConfig:
-    """``cfg`` with another iteration budget (a resumed training may extend it).
-
-    Parameters
-    ----------
-    cfg : TrainConfig
-        Settings.
-    iterations : int
-        New budget.
-
-    Returns
-    -------
-    TrainConfig
-        The copy.
-    """
-    return replace(cfg, iterations=iterations)

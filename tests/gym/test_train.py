@@ -61,7 +61,7 @@ def test_killed_and_resumed_equals_uninterrupted(tmp_path, suite_file):
     resumed = train(cfg, tmp_path / "cut")
     assert np.array_equal(resumed.M, whole.M) and np.any(whole.M != 0)
     assert np.array_equal(resumed.mean, whole.mean) and np.array_equal(resumed.std, whole.std)
-    drop = lambda curve: [{k: v for k, v in r.items() if k != "wall_s"} for r in curve]  # noqa: E731
+    drop = lambda curve: [{k: v for k, v in r.items() if k != "wall_s"} for r in curve]
     assert drop(resumed.curve) == drop(whole.curve)
     a, b = load_policy(whole.outputs["policy"]), load_policy(resumed.outputs["policy"])
     assert np.array_equal(a["weights"][0], b["weights"][0]) and np.array_equal(a["obs_std"], b["obs_std"])
