@@ -121,3 +121,21 @@ def test_policy_runs_in_the_engine_as_the_env_would_fly_it(tmp_path):
     for name in ("rmse_x", "rmse_y", "rmse_z", "energy_tau_u", "energy_tau_r"):
         assert res.metrics[name] == pytest.approx(info["metrics"][name], rel=1e-9, abs=1e-12), name
     assert res.metrics["energy_tau_u"] > 0
+
+
+def test_shipped_policy_loads_with_its_provenance():
+    from auvtrack.control.policy import DEFAULT_POLICY, available_policies
+
+    assert DEFAULT_POLICY in available_policies()
+    prov = load_policy(DEFAULT_POLICY)["header"]["provenance"]
+    assert prov["suite"] == "auv-track-v2" and prov["tier"] == "design"
+    assert prov["command"].startswith("auvtrack train ") and prov["budget"]["env_steps"] > 0
+    assert prov["training_seeds"] == [1000, 1016] and prov["validation_seeds"] == [2000, 2008]
+
+
+def test_policy_enters_a_comparison_when_named_only():
+    from auvtrack.benchmark.suite import resolve_controllers, tracking_kinds
+
+    assert "policy" not in tracking_kinds()  # the default competitors are unchanged
+    (entry,) = resolve_controllers(["policy"])
+    assert entry.table == {"kind": "policy"}
