@@ -17,7 +17,7 @@ import warnings
 
 import click
 
-from . import compare, perf, run, scenarios, studies, sweep, tune  # noqa: F401  (each registers its commands on the group)
+from . import compare, perf, run, scenarios, studies, sweep, train, tune  # noqa: F401  (each registers its commands on the group)
 from .common import EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_SIM_FAILED, VERBOSE, cli, one_line
 
 __all__ = ["cli", "main", "EXIT_BAD_INPUT", "EXIT_SIM_FAILED", "EXIT_INTERRUPTED", "EXIT_CODES"]

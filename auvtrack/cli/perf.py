@@ -69,8 +69,11 @@ def _check_duration(duration: float, plant: str) -> None:
                    "or $XDG_DATA_HOME; never the source tree unless asked, e.g. --out benchmarks).")
 @click.option("--plant", type=click.Choice(["5dof", "6dof"]), default="5dof", show_default=True,
               help="Plant model: 5dof (Section 4) or 6dof (each REMUS 100 truth preset, a 1 m/s line).")
+@click.option("--gym", "gym", is_flag=True,
+              help="Gymnasium vector environment: env steps/s at N = 1, 64, 1024 and the ratio to the batch runner "
+                   "(auvtrack.perf.gym_bench).")
 def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: bool, bench_out: str | None,
-          plant: str = "5dof") -> None:
+          plant: str = "5dof", gym: bool = False) -> None:
     """Time the compiled closed loop: µs per RK4 step, one JSON line per controller (every built-in by default).
 
     --all runs the full suite (batch runs/s, Dask sweep throughput) and writes results.json and
@@ -78,6 +81,16 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
     """
     if not 1 <= repeat <= MAX_REPEAT:
         raise BadInput(f"--repeat: must be in [1, {MAX_REPEAT}] (a median needs at least one timing) (got {repeat})")
+    if gym:
+        unused = [option for option, param in (("--controller", "controllers"), ("--duration", "duration"),
+                                               ("--plant", "plant"), ("--all", "run_all"), ("--out", "bench_out"))
+                  if _option_given(param)]
+        if unused:
+            raise BadInput(f"{', '.join(unused)}: not used by --gym (it times its own cell; --repeat applies)")
+        from ..perf.gym_bench import bench_gym
+
+        click.echo(json.dumps(bench_gym(repeat=repeat)))
+        return
     if run_all:
         unused = [option for option, param in (("--controller", "controllers"), ("--duration", "duration"),
                                                ("--plant", "plant")) if _option_given(param)]

@@ -1,8 +1,9 @@
 """Controllers: registry, shared tracking kinematics and the compiled laws.
 
 Registering a built-in controller is one line: its module in :data:`BUILTIN` (checked against
-:mod:`auvtrack.control.contract`).  ``plugin`` is registered after them: it is the loader of
-controllers from outside the package (kind ``"plugin"``).
+:mod:`auvtrack.control.contract`).  ``policy`` (a learned law flying a trained file,
+:mod:`auvtrack.control.policy`) and ``plugin`` are registered after them: the first enters a
+comparison when named, the second is the loader of controllers from outside the package (kind ``"plugin"``).
 """
 from importlib import import_module
 
@@ -26,6 +27,7 @@ BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
 """Kinds of the built-in controllers (``plugin``, the loader of outside controllers, is not one)."""
 for _module in BUILTIN:
     register(_module)
+register(import_module(f"{__name__}.policy"))  # a learned law flying a trained file: not among the default competitors
 register(ControllerSpec(plugin.NAME, plugin.__name__, plugin.Params, plugin.setup,
                         "a controller module from outside the package (controller.module)"))
 

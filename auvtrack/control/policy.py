@@ -6,7 +6,8 @@ network: layers ``W_l h + b_l`` each followed by its activation (``identity``, `
 
 The file holds ``header`` (JSON: format, version, ``commands``, ``scale``, ``activations``,
 ``provenance``), ``W0, b0, W1, b1, ...``, ``obs_mean`` and ``obs_std`` (:func:`save_policy`,
-:func:`load_policy`).  Packed :data:`HEAD` then the sizes, activation codes, scale, normalisation
+:func:`load_policy`).  ``controller.file`` is a ``.npz`` path or the name of a policy shipped in
+``auvtrack/data/policies`` (:func:`available_policies`; default :data:`DEFAULT_POLICY`).  Packed :data:`HEAD` then the sizes, activation codes, scale, normalisation
 and the weights; the hidden activations use the law's scratch.
 """
 from __future__ import annotations
@@ -28,17 +29,50 @@ from .registry import CompiledController, ControllerParams
 NAME = "policy"
 AUX_NAMES: tuple[str, ...] = ()
 COMMANDS = "tau"
-TRACKS = False
 ACTIVATIONS = ("identity", "tanh", "relu")
 FORMAT = "auvtrack-policy"
 HEAD = packed_layout("PolicyHead", n_layers=1, rest=None)
+SHIPPED = Path(__file__).resolve().parents[1] / "data" / "policies"
+DEFAULT_POLICY = "remus100-ars"
+"""The shipped policy ``controller.kind = "policy"`` flies without a ``file``."""
+
+
+def available_policies() -> list[str]:
+    """Names of the policies shipped with the package.
+
+    Returns
+    -------
+    list of str
+        Sorted names (files ``auvtrack/data/policies/<name>.npz``).
+    """
+    return sorted(p.stem for p in SHIPPED.glob("*.npz"))
+
+
+def policy_path(file: str | Path) -> Path:
+    """The file of a policy: a shipped name (no suffix, no folder) or a path.
+
+    Parameters
+    ----------
+    file : str or Path
+        Name or path.
+
+    Returns
+    -------
+    Path
+        The ``.npz`` file (not checked to exist).
+    """
+    p = Path(file)
+    if p.suffix == "" and p.parent == Path("."):
+        return SHIPPED / f"{p.name}.npz"
+    return p.expanduser()
 
 
 class Params(ControllerParams):
-    """A policy file (``.npz``, :func:`save_policy`)."""
+    """A policy: a shipped name or a ``.npz`` file (:func:`save_policy`)."""
 
     kind: Literal["policy"] = "policy"
-    file: str = Field(..., min_length=1, description="the policy's .npz file")
+    file: str = Field(DEFAULT_POLICY, min_length=1,
+                      description="a shipped policy's name (auvtrack/data/policies) or a .npz file")
 
 
 def save_policy(path: str | Path, weights, biases, activations, scale, obs_mean=None, obs_std=None,
@@ -86,7 +120,7 @@ def load_policy(path: str | Path) -> dict[str, Any]:
     Parameters
     ----------
     path : str or Path
-        The ``.npz`` file.
+        The ``.npz`` file or a shipped policy's name (:func:`policy_path`).
 
     Returns
     -------
@@ -98,8 +132,12 @@ def load_policy(path: str | Path) -> dict[str, Any]:
     ValueError
         One line naming what is wrong.
     """
+    path = policy_path(path)
+    if not path.is_file():
+        shipped = ", ".join(available_policies()) or "none"
+        raise ValueError(f"controller.file: no policy file {str(path)!r} (shipped policies: {shipped})")
     try:
-        with np.load(Path(path), allow_pickle=False) as z:
+        with np.load(path, allow_pickle=False) as z:
             data = {k: z[k] for k in z.files}
     except (OSError, ValueError) as exc:
         raise ValueError(f"controller.file: cannot read a policy from {path} ({exc})") from None
@@ -218,4 +256,4 @@ def setup(params: Params, ctx) -> CompiledController:
         raise ValueError(f"controller.file: the policy commands {policy['header'].get('commands')!r}, "
                          f"the plant takes {ctx.commands!r}")
     return CompiledController(cp=pack(policy), xc0=np.zeros(0),
-                              resolved={"policy": {"file": str(params.file), **policy["header"]}})
+                              resolved={"policy": {"file": str(policy_path(params.file)), **policy["header"]}})

@@ -13,10 +13,12 @@ drawn from the environment's generator): the same start, tier draws, disturbance
   scale the plant's actuator limits.
 * **Observations**: :mod:`auvtrack.control.policy_observation` (the function the ``policy`` law
   uses), a Box with its clip bounds.
-* **Reward**: minus the increments of the benchmark's metric sums over the step, weighted by the
-  suite's ``[run_score]``: ``w_rmse / (scale_rmse^2 T)`` on the integral of |e|^2, ``w_energy /
-  scale_energy`` on the integral of |tau|^2, ``w_tv / scale_tv`` on tau's total variation; a failure
-  costs ``cap + 1`` (a failed run's score).  ``terminated``: the engine's failure causes;
+* **Reward**: minus the increment over the step of the episode's cost, built from the benchmark's
+  metric sums and the suite's ``[run_score]`` (weights w, scales s, cap): w_rmse min((rmse/s_rmse)^2,
+  cap^2) on the integral of |e|^2 over the task's duration T, w_energy min(E/s_energy, cap) on the
+  integral of |tau|^2, w_tv min(TV/s_tv, cap) on tau's total variation
+  (:func:`~auvtrack.gym.stepping.episode_cost`); a failure costs one more than the sum of the three
+  caps, so a failed episode returns less than any completed one.  ``terminated``: the engine's failure causes;
   ``truncated``: the task's duration reached.  ``info["metrics"]`` at the end: the run's benchmark
   metrics (:func:`auvtrack.metrics.metrics_finalize`), ``info["status"]``, ``info["seed_index"]``.
 """
@@ -157,9 +159,10 @@ class TrackEnv(gym.Env):
         rs = self.suite.file.run_score
         if not any(w > 0 for w in rs.weights.values()):  # a suite without a run score: the error alone
             rs = rs.model_copy(update={"weights": {"rmse": 1.0}, "scales": {"rmse": 1.0}})
-        self._weights = (rs.weights.get("rmse", 0.0) / rs.scales.get("rmse", 1.0) ** 2,
-                         rs.weights.get("energy", 0.0) / rs.scales.get("energy", 1.0),
-                         rs.weights.get("tv", 0.0) / rs.scales.get("tv", 1.0), rs.cap + 1.0)
+        w = [rs.weights.get(k, 0.0) for k in ("rmse", "energy", "tv")]
+        caps = (w[0] * rs.cap ** 2, w[1] * rs.cap, w[2] * rs.cap)
+        self._weights = (w[0] / rs.scales.get("rmse", 1.0) ** 2, w[1] / rs.scales.get("energy", 1.0),
+                         w[2] / rs.scales.get("tv", 1.0), *caps, 1.0 + sum(caps))
         self.prep: Prepared | None = None
         self.seed_index = 0
 

@@ -26,13 +26,13 @@ from ..engine.loop import (  # the engine's parts this step is built of (rebound
 from ..metrics import METRICS_SIZE, OFF_E2, OFF_TEN, OFF_TV, metrics_init
 from ..plant.contract import SCRATCH_SIZE
 
-__all__ = ["Carry", "new_carry", "step_module", "REWARD", "PARALLEL_FROM"]
+__all__ = ["Carry", "new_carry", "step_module", "episode_cost", "REWARD", "PARALLEL_FROM"]
 
 PARALLEL_FROM = 256
 """Envs from which a step runs in the thread pool (``step_all``) rather than in one thread (``step_serial``)."""
 
-REWARD = ("w_error", "w_energy", "w_tv", "penalty")
-"""Reward weights per env (row of ``Carry.rw``): see :func:`env_step`."""
+REWARD = ("k_error", "k_energy", "k_tv", "cap_error", "cap_energy", "cap_tv", "penalty")
+"""Reward terms per env (row of ``Carry.rw``): see :func:`episode_cost`."""
 
 
 class Carry(NamedTuple):
@@ -81,10 +81,9 @@ def new_carry(n: int, nxp: int, nxc: int, ncmd: int, nobs: int) -> Carry:
 def env_step(ins, c, i, bound):
     """One control period of env ``i``: write ``c.obs[i]``, ``c.reward[i]``, ``c.cause[i]``; return the cause.
 
-    The reward is minus the increments, over the period, of the metrics accumulator's sum of
-    squared error times dt (weight ``rw[0]``), sum of squared tau times dt (``rw[1]``) and
-    total variation of tau (``rw[2]``); a failure adds ``-rw[3]``.  ``ks[i]`` = (RK4 step, saturation
-    flags).  At the end of the run (step ``n_steps``) nothing is integrated and the cause is 0.
+    The reward is minus the increment of :func:`episode_cost` over the period; a failure adds
+    ``-rw[6]``.  ``ks[i]`` = (RK4 step, saturation flags).  At the end of the run (step
+    ``n_steps``) nothing is integrated and the cause is 0.
     """
     pp, cp, vp, path = ins.pp[i], ins.cp[i], ins.vp[i], ins.path[i]
     si, sf, noise = ins.si[i], ins.sf[i], ins.noise[i]
@@ -104,9 +103,7 @@ def env_step(ins, c, i, bound):
     aux1, aux = np.zeros(1), np.zeros(1)
     reuse = state_free_disturbance(ins.rows[i])
     t_late = 0.5 * (sf[SF.win_t0] + min(sf[SF.win_t1], n_steps * dt))
-    before = 0.0
-    for j in range(3):
-        before += rw[0] * acc[OFF_E2 + j] + rw[1] * acc[OFF_TEN + j] + rw[2] * acc[OFF_TV + j]
+    before = episode_cost(rw, acc)
     k, sat = c.ks[i, 0], c.ks[i, 1]
     cause = CAUSE_NONE
     for _ in range(ctrl_every):
@@ -167,13 +164,26 @@ def env_step(ins, c, i, bound):
             xc[m] = xcn[m]
         k += 1
     c.ks[i, 0], c.ks[i, 1] = k, sat
-    after = 0.0
-    for j in range(3):
-        after += rw[0] * acc[OFF_E2 + j] + rw[1] * acc[OFF_TEN + j] + rw[2] * acc[OFF_TV + j]
-    c.reward[i] = before - after - (rw[3] if cause != CAUSE_NONE else 0.0)
+    c.reward[i] = before - episode_cost(rw, acc) - (rw[6] if cause != CAUSE_NONE else 0.0)
     c.cause[i] = cause
     env_observe(ins, c, i, bound)
     return cause
+
+
+def episode_cost(rw, acc):
+    """The cost of the episode so far: sum over (error, energy, tv) of min(k * S, cap).
+
+    S are the metrics accumulator's sums over the axes: of squared error times dt, of squared
+    tau times dt, and tau's total variation; ``rw`` = (k_error, k_energy, k_tv, cap_error,
+    cap_energy, cap_tv, penalty) (:data:`REWARD`).  Capped, so that a completed episode costs at most
+    the sum of the caps (the failure penalty is more).
+    """
+    s_e, s_n, s_v = 0.0, 0.0, 0.0
+    for j in range(3):
+        s_e += acc[OFF_E2 + j]
+        s_n += acc[OFF_TEN + j]
+        s_v += acc[OFF_TV + j]
+    return min(rw[0] * s_e, rw[3]) + min(rw[1] * s_n, rw[4]) + min(rw[2] * s_v, rw[5])
 
 
 def env_observe(ins, c, i, bound):
@@ -210,7 +220,7 @@ def observe_all(ins, c, bound):
         env_observe(ins, c, i, bound)
 
 
-PARTS = {"env_step": "njit(nogil=True)", "env_observe": "njit(nogil=True)",
+PARTS = {"episode_cost": "njit(nogil=True, inline='always')", "env_step": "njit(nogil=True)", "env_observe": "njit(nogil=True)",
          "step_all": "njit(nogil=True, parallel=True)", "step_serial": "njit(nogil=True)", "observe_all": "njit(nogil=True)"}
 
 

@@ -4,8 +4,12 @@ Rows of the engine's :class:`~auvtrack.engine.loop.Stacked` inputs and of the
 :class:`~auvtrack.gym.stepping.Carry` are the envs; :meth:`step` writes the actions into the rows'
 replay tables and calls the step module's ``step_all`` once.  Autoreset follows Gymnasium's
 default (``NEXT_STEP``): the step after an env ended resets it (seed index drawn from the vector
-env's generator) and returns its first observation with reward 0.  A reset prepares that env's
-run in Python (once per episode); the step itself runs no per-env Python.
+env's generator) and returns its first observation with reward 0; with ``autoreset="disabled"``
+an ended env stays ended (not stepped, reward 0) until :meth:`reset`.  A reset prepares that env's
+run in Python (once per seed index: the prepared rows are kept for the next episode of that index);
+the step itself runs no per-env Python.  At an episode's end ``info`` carries its benchmark
+metrics (``info["metrics"]``, ``info["status"]``, ``info["t"]``, object arrays, with the masks
+``info["_metrics"]`` ... of the envs that ended, Gymnasium's vector-info convention).
 """
 from __future__ import annotations
 
@@ -18,7 +22,9 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 
 from ..benchmark.suite import Suite
 from ..control.policy_observation import OBS_BOUND
-from ..engine.loop import SI
+from ..engine.loop import CAUSES, SI
+from ..metrics import metrics_finalize
+from ..plant.contract import SF
 from .env import TrackEnv
 from .replay import GAINS
 from .stepping import PARALLEL_FROM, new_carry
@@ -33,13 +39,23 @@ class TrackVectorEnv(VectorEnv):
         Environments.
     suite, task, tier, action, substeps, duration
         As :class:`~auvtrack.gym.env.TrackEnv`.
+    autoreset : str, optional
+        ``"next_step"`` (default, Gymnasium's) or ``"disabled"``.
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP}
+    AUTORESET = {"next_step": AutoresetMode.NEXT_STEP, "disabled": AutoresetMode.DISABLED}
+    KEEP = 512
+    """Prepared seed indices kept (the oldest is dropped beyond)."""
 
     def __init__(self, num_envs: int, suite: str | Path | Suite = "auv-track-v1", task: str | None = None,
                  tier: str | None = None, action: str = "tau", substeps: int = 10,
-                 duration: float | None = None) -> None:
+                 duration: float | None = None, autoreset: str = "next_step") -> None:
+        if autoreset not in self.AUTORESET:
+            raise ValueError(f"autoreset: must be one of {', '.join(self.AUTORESET)} (got {autoreset!r})")
+        if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
+            raise ValueError(f"num_envs: must be an integer >= 1 (got {num_envs!r})")
+        self.metadata = {**self.metadata, "autoreset_mode": self.AUTORESET[autoreset]}
         self.num_envs = int(num_envs)
         self.one = TrackEnv(suite, task, tier, action=action, substeps=substeps, duration=duration)
         self.single_observation_space = self.one.observation_space
@@ -49,11 +65,23 @@ class TrackVectorEnv(VectorEnv):
         self.ins = self.carry = None
         self._done = np.zeros(self.num_envs, bool)
         self.seed_indices = np.zeros(self.num_envs, np.int64)
+        self.windows = np.zeros((self.num_envs, 2))
+        self._prepared: dict[int, tuple] = {}
+
+    def _rows(self, index: int) -> tuple:
+        """The prepared inputs, fresh carry and metrics window of seed index ``index`` (kept once made)."""
+        if index not in self._prepared:
+            if len(self._prepared) >= self.KEEP:
+                self._prepared.pop(next(iter(self._prepared)))
+            self.one.reset(seed=index)
+            one_ins, one_c = self.one.ins, self.one.carry
+            self._prepared[index] = (one_ins, type(one_c)(*[a.copy() for a in one_c]),
+                                     tuple(self.one.prep.scenario.metrics.window))
+        return self._prepared[index]
 
     def _load(self, i: int, index: int) -> None:
         """Prepare env ``i`` for seed index ``index`` and copy its rows in."""
-        self.one.reset(seed=index)
-        one_ins, one_c = self.one.ins, self.one.carry
+        one_ins, one_c, window = self._rows(index)
         if self.ins is None:
             self.ins = type(one_ins)(*[np.repeat(a, self.num_envs, axis=0) for a in one_ins])
             self.carry = new_carry(self.num_envs, one_c.xp.shape[1], one_c.xc.shape[1], one_c.cmd.shape[1],
@@ -64,6 +92,7 @@ class TrackVectorEnv(VectorEnv):
         for dst, src in zip(self.carry, one_c):
             dst[i] = src[0]
         self.seed_indices[i] = index
+        self.windows[i] = window
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
         """Reset every env: seed indices ``seed + i`` (or the given list, or drawn).
@@ -108,11 +137,14 @@ class TrackVectorEnv(VectorEnv):
             Observations, rewards, terminated, truncated, info (``metrics`` of the envs that ended
             is left to :class:`~auvtrack.gym.env.TrackEnv`; here ``seed_index``).
         """
+        if self.carry is None:
+            raise RuntimeError("call reset() before step()")
         a = np.clip(np.asarray(actions, dtype=np.float64).reshape(self.num_envs, 3), -1.0, 1.0)
         c, ins = self.carry, self.ins
         ended = np.flatnonzero(self._done)
-        for i in ended:  # NEXT_STEP autoreset: these envs start a new episode now
-            self._load(int(i), int(self._np_random.integers(0, 2**31 - 1)))
+        if self.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP:
+            for i in ended:  # these envs start a new episode now
+                self._load(int(i), int(self._np_random.integers(0, 2**31 - 1)))
         ctrl_every = ins.si[:, SI.ctrl_every]
         rows = np.minimum(c.ks[:, 0] // ctrl_every, ins.cp[:, GAINS.n].astype(np.int64) - 1)
         cols = GAINS.table + 3 * rows[:, None] + np.arange(3)[None, :]
@@ -125,5 +157,36 @@ class TrackVectorEnv(VectorEnv):
         reward = np.where(live, c.reward, 0.0)
         terminated = live & (c.cause != 0)
         truncated = live & ~terminated & (c.ks[:, 0] >= ins.si[:, SI.n_steps])
-        self._done = terminated | truncated
-        return c.obs.copy(), reward, terminated, truncated, {"seed_index": self.seed_indices.copy()}
+        ending = terminated | truncated
+        disabled = self.metadata["autoreset_mode"] == AutoresetMode.DISABLED
+        self._done = (self._done | ending) if disabled else ending
+        info = {"seed_index": self.seed_indices.copy()}
+        if ending.any():
+            info.update(self.episode_infos(ending))
+        return c.obs.copy(), reward, terminated, truncated, info
+
+    def episode_infos(self, mask: np.ndarray) -> dict[str, np.ndarray]:
+        """The benchmark metrics, status and end time of the envs in ``mask`` (vector-info form).
+
+        Parameters
+        ----------
+        mask : numpy.ndarray
+            (num_envs,) bool: the envs to report.
+
+        Returns
+        -------
+        dict
+            ``metrics``, ``status``, ``t`` (object arrays, None where not reported) and their masks
+            ``_metrics``, ``_status``, ``_t``.
+        """
+        c, ins = self.carry, self.ins
+        metrics, status, t = (np.full(self.num_envs, None, dtype=object) for _ in range(3))
+        for i in np.flatnonzero(mask):
+            t_end = int(c.ks[i, 0]) * float(ins.sf[i, SF.dt])
+            t0, t1 = self.windows[i]
+            metrics[i] = metrics_finalize(c.acc[i].copy(), t0, min(t1, t_end))
+            cause = int(c.cause[i])
+            status[i] = "ok" if cause == 0 else CAUSES.get(cause, ("controller", ""))[0]
+            t[i] = t_end
+        m = np.asarray(mask, bool).copy()
+        return {"metrics": metrics, "status": status, "t": t, "_metrics": m, "_status": m.copy(), "_t": m.copy()}

@@ -92,3 +92,46 @@ def test_check_env_six_dof_truth(action):
         if te or tr:
             break
     assert tr and info["status"] == "ok" and np.isfinite(r)
+
+
+SCORED = Suite(SuiteFile.model_validate(tomllib.loads(
+    TINY + "\n[run_score]\ncap = 3.0\n[run_score.weights]\nrmse = 1.0\nenergy = 0.5\ntv = 0.25\n"
+    "[run_score.scales]\nrmse = 0.04\nenergy = 20.0\ntv = 50.0\n")), "tiny-scored")
+
+
+def test_return_is_the_capped_benchmark_cost():
+    """Sum of rewards == -(w_rmse min((rmse/s)^2, cap^2) + w_E min(E/s, cap) + w_TV min(TV/s, cap)), from the metrics."""
+    rng = np.random.default_rng(5)
+    capped = []
+    for seed, amp in ((0, 0.1), (1, 1.0)):
+        env = TrackEnv(SCORED, "helix", "calm", duration=1.0)
+        env.reset(seed=seed)
+        ret, done = 0.0, False
+        while not done:
+            _, r, te, tr, info = env.step(amp * rng.uniform(-1, 1, 3))
+            ret += r
+            done = te or tr
+        assert info["status"] == "ok"
+        m = info["metrics"]
+        dur = info["t"] - env.prep.scenario.metrics.window[0]
+        ms2 = sum(m[f"rmse_{a}"] ** 2 for a in "xyz") * dur / 1.0  # integral of |e|^2 over T = 1 s
+        energy = sum(v for k, v in m.items() if k.startswith("energy_tau_"))
+        tv = sum(v for k, v in m.items() if k.startswith("tv_tau_")) * dur
+        cost = min(ms2 / 0.04 ** 2, 9.0) + 0.5 * min(energy / 20.0, 3.0) + 0.25 * min(tv / 50.0, 3.0)
+        assert ret == pytest.approx(-cost, rel=1e-9)
+        capped.append((ms2 / 0.04 ** 2 > 9.0, energy / 20.0 > 3.0, tv / 50.0 > 3.0))
+        assert cost > 0
+    assert capped == [(True, False, False), (False, False, True)]  # the caps are met
+
+
+def test_a_failed_episode_returns_less_than_any_completed_one():
+    env = TrackEnv(SCORED, "line", "calm", duration=30.0)
+    env.reset(seed=0)
+    ret, done = 0.0, False
+    while not done:  # full surge and pitch torque: the pitch limit
+        _, r, te, tr, info = env.step(np.array([1.0, 1.0, 0.0]))
+        ret += r
+        done = te or tr
+    assert te and info["status"] == "pitch_limit"
+    worst_completed = -(9.0 + 0.5 * 3.0 + 0.25 * 3.0)  # every capped term at its cap
+    assert ret < worst_completed - 1.0 + 1e-9

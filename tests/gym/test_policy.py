@@ -22,11 +22,26 @@ def _random_policy(tmp_path, rng, sizes=(16, 8), acts=("tanh", "relu", "identity
                                    rng.uniform(0.5, 3.0, OBS.size)))
 
 
-def test_contract_checked():
-    from auvtrack.control import check_controller
+def test_registered_kind_contract_checked():
+    from auvtrack.control import BUILTIN_NAMES, CONTROLLERS, check_controller
     from auvtrack.control import policy
 
-    assert check_controller(policy, plugin=True).name == "policy"
+    assert check_controller(policy).name == "policy" and CONTROLLERS["policy"].tracks
+    assert "policy" not in BUILTIN_NAMES  # named to compete, never a default competitor
+
+
+def test_missing_policy_file_one_line(tmp_path):
+    from auvtrack.cli import main
+
+    scen = tmp_path / "s.toml"
+    scen.write_text('[controller]\nkind = "policy"\nfile = "nope.npz"\n[sim]\nduration = 0.1\n')
+    import io
+    import contextlib
+
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main(["check", str(scen)])
+    assert code == 2 and len(err.getvalue().strip().splitlines()) == 1 and "controller.file" in err.getvalue()
 
 
 def test_law_equals_numpy_forward(tmp_path):
@@ -82,7 +97,7 @@ def test_malformed_file_refused(tmp_path):
 
 
 def test_policy_runs_in_the_engine_as_the_env_would_fly_it(tmp_path):
-    """A policy run (controller.module = auvtrack.control.policy) == the env driven by the NumPy forward pass."""
+    """A policy run (controller.kind = "policy") == the env driven by the NumPy forward pass."""
     from auvtrack.gym.env import episode_scenario
     from auvtrack.scenario import load_scenario
     from auvtrack.simulation.pipeline import simulate
@@ -100,9 +115,27 @@ def test_policy_runs_in_the_engine_as_the_env_would_fly_it(tmp_path):
             break
     sc = episode_scenario(SUITE, "helix", "calm", 4, duration=0.5)
     raw = sc.to_dict()
-    raw["controller"] = {"kind": "plugin", "module": "auvtrack.control.policy", "params": {"file": str(pol_file)}}
+    raw["controller"] = {"kind": "policy", "file": str(pol_file)}
     res = simulate(load_scenario(raw))
     assert res.status == "ok" and info["status"] == "ok"
     for name in ("rmse_x", "rmse_y", "rmse_z", "energy_tau_u", "energy_tau_r"):
         assert res.metrics[name] == pytest.approx(info["metrics"][name], rel=1e-9, abs=1e-12), name
     assert res.metrics["energy_tau_u"] > 0
+
+
+def test_shipped_policy_loads_with_its_provenance():
+    from auvtrack.control.policy import DEFAULT_POLICY, available_policies
+
+    assert DEFAULT_POLICY in available_policies()
+    prov = load_policy(DEFAULT_POLICY)["header"]["provenance"]
+    assert prov["suite"] == "auv-track-v2" and prov["tier"] == "design"
+    assert prov["command"].startswith("auvtrack train ") and prov["budget"]["env_steps"] > 0
+    assert prov["training_seeds"] == [1000, 1016] and prov["validation_seeds"] == [2000, 2008]
+
+
+def test_policy_enters_a_comparison_when_named_only():
+    from auvtrack.benchmark.suite import resolve_controllers, tracking_kinds
+
+    assert "policy" not in tracking_kinds()  # the default competitors are unchanged
+    (entry,) = resolve_controllers(["policy"])
+    assert entry.table == {"kind": "policy"}

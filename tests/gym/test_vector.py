@@ -29,3 +29,23 @@ def test_rows_equal_single_env_and_autoreset():
     obs, rew, term, trunc, info = vec.step(acts[0])  # the autoreset step: new episodes, reward 0
     assert np.all(rew == 0.0) and not term.any() and not trunc.any()
     assert np.all(vec.carry.ks[:, 0] == 0)
+
+
+def test_episode_metrics_in_info_and_disabled_autoreset():
+    dur = 0.4
+    vec = TrackVectorEnv(2, SUITE, "helix", "calm", duration=dur, autoreset="disabled")
+    single = TrackEnv(SUITE, "helix", "calm", duration=dur)
+    vec.reset(seed=[7, 8])
+    single.reset(seed=8)
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        a = rng.uniform(-1, 1, (2, 3))
+        _, _, te, tr, info = vec.step(a)
+        _, _, ste, strn, sinfo = single.step(a[1])
+    assert tr.all() and list(info["_metrics"]) == [True, True] and (ste or strn)
+    assert info["status"][1] == sinfo["status"] == "ok" and info["t"][1] == sinfo["t"]
+    assert info["metrics"][1] == sinfo["metrics"]
+    ks = vec.carry.ks[:, 0].copy()
+    obs, rew, te, tr, info = vec.step(np.zeros((2, 3)))  # ended envs stay ended
+    assert np.all(rew == 0.0) and not te.any() and not tr.any() and "metrics" not in info
+    assert np.array_equal(vec.carry.ks[:, 0], ks)
