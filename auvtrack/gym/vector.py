@@ -14,7 +14,6 @@ metrics (``info["metrics"]``, ``info["status"]``, ``info["t"]``, object arrays, 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import gymnasium as gym
 import numpy as np
