@@ -81,7 +81,12 @@ def probe(prep, *, notice=None) -> None:
     def stop() -> None:
         out.info[engine.INFO_STOP] = 1
 
-    outcome = run_in_thread(lambda: call_kernel(short, out), stop, reraise=False, timeout=PROBE_WALL_S)
+    for _ in range(2):  # once more when the first call spent the wall time loading or compiling the kernel
+        loaded = bool(kernels.kernel(key).signatures)
+        outcome = run_in_thread(lambda: call_kernel(short, out), stop, reraise=False, timeout=PROBE_WALL_S)
+        if loaded or not outcome.timed_out or outcome.abandoned or outcome.interrupted:
+            break
+        out = outputs_for(short, rows=0)
     if outcome.interrupted:
         raise KeyboardInterrupt
     if outcome.abandoned:  # timed out and the law never came back to the loop

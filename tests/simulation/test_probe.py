@@ -134,3 +134,36 @@ def test_a_law_that_never_returns_is_refused_after_the_probes_wall_time(tmp_path
     err = [ln for ln in p.stderr.splitlines() if not ln.startswith("compiling kernels")]
     assert len(err) == 1 and "control did not return within 3 s of wall time" in err[0] and "law.py" in err[0]
     assert not out.exists() and time.monotonic() - t0 < 300
+
+
+def test_a_first_call_that_spends_the_wall_time_loading_the_kernel_is_run_again(tmp_path, monkeypatch):
+    """A kernel not yet loaded in this process loads (or compiles) in the probe's first call, holding
+    the GIL, so that call can use up the wall time before the law runs: the probe runs once more
+    instead of letting the law go unprobed."""
+    import time
+    from types import SimpleNamespace
+
+    from auvtrack.engine import kernels
+    from auvtrack.scenario import load_scenario
+    from auvtrack.simulation import pipeline, probe as probe_module
+
+    prep = pipeline.prepare(load_scenario(str(_scenario(tmp_path, OUT_OF_BOUNDS))))
+    monkeypatch.setattr(probe_module, "PROBE_WALL_S", 0.5)
+    real_kernel, real_call, calls = kernels.kernel, pipeline.call_kernel, []
+
+    class NotLoaded:  # what the probe finds before its first call: no signature loaded yet
+        signatures = ()
+
+    def first_call_loads(p, out):
+        calls.append(p.key)
+        if len(calls) == 1:
+            time.sleep(1.0)  # past the wall time, as a kernel compiling in the thread
+            return 0, 0, 0.0  # and then the loop saw the stop request at its first step
+        return real_call(p, out)
+
+    seen = SimpleNamespace(warmup=kernels.warmup, kernel=lambda key: NotLoaded if not calls else real_kernel(key))
+    monkeypatch.setattr(probe_module, "kernels", seen)
+    monkeypatch.setattr(pipeline, "call_kernel", first_call_loads)
+    with pytest.raises(LawFault, match=rf"law.py:{OOB_LINE}: control raised IndexError"):
+        probe_module.probe(prep)
+    assert len(calls) == 2
