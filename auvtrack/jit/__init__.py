@@ -17,17 +17,19 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import importlib
 import os
 import types as pytypes
 from pathlib import Path
 
 import numba
-from numba.core import errors, types
+from numba.core import types
+from numba.core.errors import TypingError
 from numba.core.registry import CPUDispatcher
 
-from . import lane_values as _lanes  # noqa: F401  (lane types registered before anything compiles)
 from . import vecmath as _vecmath
 
+importlib.import_module(f"{__name__}.lane_values")  # registers the lane types with Numba before anything compiles
 _PKG = Path(__file__).resolve().parents[1]
 COMPILED = ("jit", "packing.py", "channels.py", "metrics.py", "fields.py", "user_modules.py", "_seeding.py",
             "interrupt.py", "vehicle", "plant", "environment", "reference", "control", "engine",
@@ -99,7 +101,7 @@ class PlainArgsDispatcher(CPUDispatcher):
         if plain != tuple(args) or plain_kws != kws:
             try:
                 return super().get_call_template(plain, plain_kws)
-            except errors.TypingError:
+            except TypingError:
                 pass
         return super().get_call_template(args, kws)
 

@@ -28,6 +28,7 @@ class CompileError(ValueError):
 
 
 _LOCATION = re.compile(r'File "([^"]+)", line (\d+)')
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")  # Numba's highlighting (its colour scheme may be on)
 _NOISE = ("Failed in ", "During:", "File ", "Enable logging", "This error may have been", "Traceback",
           "numba.core.errors", "raise ", "^", "Exception", "<source", "    ")
 
@@ -48,6 +49,7 @@ def compile_error_line(text: str, label: str) -> str:
         ``"<label>: cannot compile: <file>:<line>: <cause>"`` (the generated kernel file and the
         package's own files are never named: the user's code is).
     """
+    text = _ANSI.sub("", text)
     package = str(Path(__file__).resolve().parents[1])
     cache = str(cache_dir().parent)
     found = [(os.path.abspath(f), n) for f, n in _LOCATION.findall(text)]  # Numba may report paths relative to cwd

@@ -117,3 +117,33 @@ def attitude_cause(x, sf):
 def log_extra(x, cmd, pp, log, row, col):
     """Write the plant's extra channels into ``log[row, col:col + N_LOG]``."""
     raise NotImplementedError
+
+
+def example_arguments(x0, pp, n_cmd: int) -> dict:
+    """Arguments of each compiled function with the types the engine's loop passes (to compile one alone).
+
+    Parameters
+    ----------
+    x0 : numpy.ndarray
+        A state (float64, C-contiguous; its length is the plant's ``NX``).
+    pp : numpy.ndarray
+        The packed parameters (float64, 1-D).
+    n_cmd : int
+        ``N_CMD``: the length of the actuator command.
+
+    Returns
+    -------
+    dict
+        Function name -> tuple of arguments (zeros, of the loop's types: 5- and 3-tuples of float,
+        float64 arrays, an int64 row and column, a bool ``fresh``).
+    """
+    import numpy as np
+
+    x, dx, cmd = np.zeros_like(x0), np.zeros_like(x0), np.zeros(n_cmd)
+    f3, f5, att = (0.0,) * 3, (0.0,) * 5, (1.0, 0.0, 1.0, 0.0)
+    env = (np.zeros((1, 1)), np.zeros((1, 1)))
+    xcp = (x, cmd, pp)
+    return {"pose": (x,), "accel5": (dx,), "allocate": (f3, f5, f5, x, pp, cmd, 0.0, cmd),
+            "rhs": (0.0, x, att, cmd, env, pp, np.zeros(SCRATCH_SIZE), True, dx), "applied": xcp,
+            "feedback": xcp, "effort": xcp, "attitude_cause": (x, np.zeros(SF.size)),
+            "log_extra": (*xcp, np.zeros((1, 1)), 0, 0)}

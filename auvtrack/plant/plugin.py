@@ -23,7 +23,7 @@ from .registry import CompiledPlant, PlantContext, PlantSection, PlantSpec, chec
 
 NAME = "plugin"
 
-__all__ = ["Section", "setup", "load", "spec_of", "CompiledPlant", "PlantContext", "PlantSection", "njit",
+__all__ = ["Section", "setup", "load", "spec_of", "compile_functions", "CompiledPlant", "PlantContext", "PlantSection", "njit",
            "njit_noalloc", "CAUSE_PITCH", "CAUSE_ROLL", "SCRATCH_SIZE", "SF"]
 
 
@@ -138,5 +138,42 @@ def setup(section: Section, ctx: PlantContext) -> CompiledPlant:
                          f"{len(spec.state)} names")
     if pp.ndim != 1:
         raise ValueError(f"plant.module: {section.module}: setup's pp must be a 1-D array (got shape {pp.shape})")
+    compile_functions(mod, section.module, pp, x0, len(spec.command))
     return dataclasses.replace(cp, pp=pp, x0=x0, log_names=spec.log_names, module=section.module,
                                resolved={**cp.resolved, "plugin": {"module": section.module, "params": section.params}})
+
+
+def compile_functions(mod, module: str, pp, x0, n_cmd: int) -> None:
+    """Compile each of the plug-in's compiled functions alone, with the types the loop passes.
+
+    A typing error then names the plug-in's file and line at set-up (``check`` and ``run`` alike),
+    not the generated kernel that calls it.  Nothing runs: the functions are compiled only (and
+    cached on disk like the kernel).
+
+    Parameters
+    ----------
+    mod : module
+        The plug-in plant.
+    module : str
+        Its ``plant.module`` (for the message).
+    pp, x0 : numpy.ndarray
+        What its ``setup`` returned.
+    n_cmd : int
+        The length of its command.
+
+    Raises
+    ------
+    auvtrack.jit.errors.CompileError
+        ``plant.module: <file>: cannot compile: <file>:<line>: <cause>``.
+    """
+    import numba
+    from numba.core.errors import NumbaError
+
+    from ..jit.errors import CompileError, compile_error_line
+    from .contract import example_arguments
+
+    for name, args in example_arguments(x0, pp, n_cmd).items():
+        try:
+            getattr(mod, name).compile(tuple(numba.typeof(a) for a in args))
+        except NumbaError as exc:
+            raise CompileError(f"plant.module: {compile_error_line(str(exc), module)}", str(exc)) from None

@@ -87,3 +87,32 @@ def test_a_broken_plant_is_refused_in_one_line_naming_the_file(tmp_path, case):
     assert main(["check", str(scenario)]) == EXIT_BAD_INPUT
     assert main(["run", str(scenario), "--out", str(tmp_path / "run")]) == EXIT_BAD_INPUT
     assert not (tmp_path / "run").exists()
+
+
+def test_a_plant_with_a_typing_error_is_refused_in_one_line_naming_its_file_and_line(tmp_path, capsys):
+    """The plug-in's functions are compiled alone at set-up: check and run name the user's line, not the kernel."""
+    text = EXAMPLE.read_text()
+    assert "    dx[2] = 0.0\n" in text
+    path = tmp_path / "typo_plant.py"
+    path.write_text(text.replace("    dx[2] = 0.0\n", "    dx[2] = object()\n"))
+    line = path.read_text().splitlines().index("    dx[2] = object()") + 1
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('[plant]\nmodel = "plugin"\nmodule = "typo_plant.py"\n')
+    for args in (["check", str(scenario)], ["run", str(scenario), "--out", str(tmp_path / "run")]):
+        assert main(args) == EXIT_BAD_INPUT
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+        assert f"plant.module: {path}: cannot compile: {path}:{line}: Untyped global name 'object'" in err, err
+    assert not (tmp_path / "run").exists()
+
+
+def test_compile_error_line_reads_a_highlighted_report(tmp_path):
+    """Numba's colour scheme wraps the report in ANSI codes; the line keeps the user's location and the cause."""
+    from auvtrack.jit.errors import compile_error_line
+
+    user = tmp_path / "p.py"
+    report = ("\x1b[1m\x1b[1mFailed in nopython mode pipeline (step: nopython frontend)\n"
+              "\x1b[1m\x1b[1mUntyped global name 'object':\x1b[0m \x1b[1mCannot determine Numba type\x1b[0m\n"
+              f'\x1b[1m\nFile "{user}", line 7:\x1b[0m\n')
+    assert compile_error_line(report, "k") == (f"k: cannot compile: {user}:7: Untyped global name 'object': "
+                                               "Cannot determine Numba type")
