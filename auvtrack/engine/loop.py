@@ -378,6 +378,10 @@ def run(pb, cb, env, ref_p, settings, out):
     sat = 0  # saturation flags of the command in force
     tau1, tau = np.zeros(3), np.zeros(3)
     aux1, aux = np.zeros(max(naux, 1)), np.zeros(max(naux, 1))
+    # the law's outputs of each RK4 stage, bundled once: a bundle built in the loop costs an atomic
+    # reference-count increment and decrement per array at every stage (run is compiled with the runtime)
+    out1, out2, out3, out4 = (LawOutputs(tau1, kc1, aux1), LawOutputs(tau, kc2, aux), LawOutputs(tau, kc3, aux),
+                              LawOutputs(tau, kc4, aux))
     reuse = state_free_disturbance(env.rows)  # stage 3 may reuse stage 2's reference and omega
     t_late = 0.5 * (sf[SF.win_t0] + min(sf[SF.win_t1], n_steps * dt))  # second half of the planned window
     row = 0
@@ -391,8 +395,7 @@ def run(pb, cb, env, ref_p, settings, out):
             eval_reference(ref_p, t, refm)
             eta_t, nu_t = plant.pose(xp)
             eta, nu = measure(eta_t, nu_t, env.noise, k // ctrl_every)
-            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf,
-                                    LawOutputs(tau1, kc1, aux1))
+            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf, out1)
             if status == 0 and not finite3(tau1):
                 status = STATUS_NONFINITE_INPUT
             if status != 0:
@@ -406,7 +409,7 @@ def run(pb, cb, env, ref_p, settings, out):
                 kc2[i] = kc3[i] = kc4[i] = kc1[i]
         # stage 1 at (t, x): also the values that are logged and enter the metrics
         att = plant_attitude(xp)
-        status, flags = stage(t, xp, xc, att, lp, buf, kp1, LawOutputs(tau1, kc1, aux1), True)
+        status, flags = stage(t, xp, xc, att, lp, buf, kp1, out1, True)
         if ctrl_every == 0:
             sat = flags
         if status == 0 and ctrl_every == 0 and not finite3(tau1):
@@ -433,20 +436,19 @@ def run(pb, cb, env, ref_p, settings, out):
             xps[i] = xp[i] + 0.5 * dt * kp1[i]
         for i in range(nxc):
             xcs[i] = xc[i] + 0.5 * dt * kc1[i]
-        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, LawOutputs(tau, kc2, aux), True)
+        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, out2, True)
         if status == 0:
             for i in range(nxp):
                 xps[i] = xp[i] + 0.5 * dt * kp2[i]
             for i in range(nxc):
                 xcs[i] = xc[i] + 0.5 * dt * kc2[i]
-            status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, LawOutputs(tau, kc3, aux),
-                              not reuse)
+            status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, out3, not reuse)
         if status == 0:
             for i in range(nxp):
                 xps[i] = xp[i] + dt * kp3[i]
             for i in range(nxc):
                 xcs[i] = xc[i] + dt * kc3[i]
-            status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, LawOutputs(tau, kc4, aux), True)
+            status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, out4, True)
         if status != 0:
             record_stop(xp, xc, xp, xc, fail_state)
             info[INFO_STATUS] = status
