@@ -34,8 +34,6 @@ import numpy as np
 from scipy.optimize import differential_evolution
 
 from ..control import get as get_controller
-from ..control import fxtntsmc
-from ..control.fxtntsmc.theory import check_theorem1
 from ..scenario import load_scenario
 from ..simulation.compiling import compile_first
 from ..simulation.pipeline import prepare, run_prepared
@@ -115,7 +113,8 @@ class GainSpace:
 # One-to-one counterparts: switching gain k1 <-> kappa1, linear reaching gain k2 <-> kappa3,
 # surface weight beta <-> a1, surface exponent gamma <-> alpha.  The FXTNTSMC box keeps every
 # condition of Theorem 1 (kappa3 > 0.5; 0.5 < alpha, a2 alpha < 1 and a4 alpha > 1 with the
-# paper's a2 = 0.8, a4 = 2); the objective re-checks them with auvtrack.control.fxtntsmc.theory.
+# paper's a2 = 0.8, a4 = 2); the objective re-checks them with the controller's ``warnings`` (for
+# the FXTNTSMC, auvtrack.control.fxtntsmc.theory.check_theorem1).
 # The baselines tune their three loop gains (docs/controllers.md) in boxes spanning two decades or
 # more around the defaults (the integral and adaptation gains down to 1e-4, near switched off); the PID's ki >= kd kp and the STA's Moreno-Osorio condition
 # (with the default L) cut parts of their boxes, which setup refuses and the objective penalises.
@@ -402,9 +401,11 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     space = SPACES[kind]
     cases = tuple(TRAIN_CASES[: budget.n_train] if cases is None else cases)
 
+    spec = get_controller(kind)
+
     def mean_cost(gains: dict[str, float]) -> float:
-        if kind == "fxtntsmc" and check_theorem1(fxtntsmc.Params(**gains)):
-            return 3.0 * objective.penalty  # outside Theorem 1 (the box already excludes it)
+        if spec.warnings is not None and spec.warnings(spec.params(**gains)):
+            return 3.0 * objective.penalty  # outside its stability conditions (the box already excludes them)
         try:
             return float(np.mean([run_cost(c, kind, gains, budget.duration, budget.dt, objective)[0]
                                   for c in cases]))
