@@ -4,6 +4,8 @@ Usage::
 
     git worktree add /tmp/base main          # the tree to compare against
     python benchmarks/ab.py /tmp/base .       # [--runs 150] [--simd N] [--set key=value ...]
+    python benchmarks/ab.py . . --set-b metrics.path=false   # one tree, two settings
+
 
 Two long-lived worker processes, one per tree (``PYTHONPATH`` set to it, its own Numba cache),
 time single metrics-only runs of the Section 4 scenario (10 s by default), or SIMD batches of N
@@ -19,7 +21,8 @@ The figures are printed and written to a Markdown file (``--out``, default ``ben
 one section per configuration (controller, plant, duration, batch size, overrides), replaced when
 that configuration is measured again, with the date, both trees' commits, the load average at the
 start and the end, the number of pairs, the medians and quartiles of each tree's times and of the
-paired ratio.
+paired ratio.  ``--set-a`` / ``--set-b`` apply an override to one tree only: the same tree twice
+with different settings times what a setting costs (e.g. ``metrics.path = false``).
 
 The workers run in a scratch folder: Python puts the current folder first on ``sys.path``, so a
 worker started inside a checkout would import that checkout whatever ``PYTHONPATH`` says.
@@ -68,6 +71,7 @@ for _ in sys.stdin:
 
 
 def _worker(root: Path, overrides: dict, batch: int) -> subprocess.Popen:
+    """A worker timing runs of ``root`` with ``overrides`` (Numba cache per tree)."""
     base = Path(os.environ.get("AUVTRACK_AB_CACHE", Path(tempfile.gettempdir()) / "auvtrack-ab"))
     cache = base / str(root.resolve()).strip("/").replace("/", "_")
     env = {**os.environ, "PYTHONPATH": str(root.resolve()), "AUVTRACK_CACHE_DIR": str(cache)}
@@ -114,15 +118,15 @@ def quartiles(values: list[float]) -> tuple[float, float, float]:
     return q1, q2, q3
 
 
-def measure(a: Path, b: Path, overrides: dict, batch: int, runs: int) -> dict:
+def measure(a: Path, b: Path, overrides: tuple[dict, dict], batch: int, runs: int) -> dict:
     """Time ``runs`` interleaved pairs of runs (or SIMD batches of ``batch`` runs) of trees ``a`` and ``b``.
 
     Parameters
     ----------
     a, b : pathlib.Path
         The two trees (A the base, B the change).
-    overrides : dict
-        Scenario overrides (dotted keys) applied to the Section 4 scenario.
+    overrides : tuple of 2 dict
+        Scenario overrides (dotted keys) applied to the Section 4 scenario, for A and for B.
     batch : int
         0 for single metrics-only runs, else the size of the SIMD batch timed.
     runs : int
@@ -132,13 +136,14 @@ def measure(a: Path, b: Path, overrides: dict, batch: int, runs: int) -> dict:
     -------
     dict
         ``times`` (two lists of seconds), ``ratio`` (the per-pair ratios B / A), ``load`` (1-minute
-        load average at the start and the end), ``identical`` and a ``metrics_note``.
+        load average at the start and the end), ``metrics_note`` and ``files``.
     """
     load0 = os.getloadavg()[0]
-    procs = [_worker(a, overrides, batch), _worker(b, overrides, batch)]
+    procs = [_worker(a, overrides[0], batch), _worker(b, overrides[1], batch)]
     files = [json.loads(p.stdout.readline()) for p in procs]  # which package each worker imported
-    if files[0] == files[1]:
-        raise SystemExit(f"both workers imported {files[0]}: compare two different trees")
+    if files[0] == files[1] and overrides[0] == overrides[1]:
+        raise SystemExit(f"both workers imported {files[0]} with the same settings: compare two different trees "
+                         "or give one of them --set-a / --set-b")
     metrics = [json.loads(p.stdout.readline()) for p in procs]
     times: list[list[float]] = [[], []]
     for i in range(runs):
@@ -152,10 +157,32 @@ def measure(a: Path, b: Path, overrides: dict, batch: int, runs: int) -> dict:
     common = sorted(set(metrics[0]) & set(metrics[1]))
     differ = [k for k in common if not _same(metrics[0][k], metrics[1][k])]
     only = [sorted(set(m) - set(common)) for m in metrics]
-    note = (f"the {len(common)} common metrics identical" if not differ else f"differing: {', '.join(differ)}")
-    note += "".join(f"; only in {t}: {', '.join(o)}" for t, o in zip("AB", only) if o)
     return {"times": times, "ratio": [y / x for x, y in zip(*times)], "load": (load0, os.getloadavg()[0]),
-            "identical": not differ and not any(only), "metrics_note": note, "files": files}
+            "metrics_note": metrics_note(len(common), differ, only), "files": files}
+
+
+def metrics_note(n_common: int, differ: list[str], only: list[list[str]]) -> str:
+    """What the two trees' metrics have in common: a sentence for the report.
+
+    Parameters
+    ----------
+    n_common : int
+        How many metrics both trees return.
+    differ : list of str
+        Those of them whose values are not bit-identical.
+    only : list of 2 lists of str
+        The metrics only tree A returns, and only tree B.
+
+    Returns
+    -------
+    str
+        E.g. ``"the 33 metrics both trees return are bit-identical; only in B: xtrack_rmse"``.
+    """
+    if differ:
+        note = f"of the {n_common} metrics both trees return, {len(differ)} differ: {', '.join(differ)}"
+    else:
+        note = f"the {n_common} metrics both trees return are bit-identical"
+    return note + "".join(f"; only in {t}: {', '.join(o)}" for t, o in zip("AB", only) if o)
 
 
 def _same(x, y) -> bool:
@@ -163,13 +190,18 @@ def _same(x, y) -> bool:
     return x == y or (x != x and y != y)
 
 
-def config_key(overrides: dict, batch: int) -> str:
-    """A short name of what was timed, e.g. ``fxtntsmc 10 s, single run``."""
+def config_key(overrides: dict, batch: int, per_tree: tuple[dict, dict] = ({}, {}), one_tree: bool = False) -> str:
+    """A short name of what was timed, e.g. ``fxtntsmc 10 s, single run``.
+
+    ``overrides`` are those of both trees, ``per_tree`` those of A only and of B only; ``one_tree``
+    when A and B are the same tree (what a setting costs, not a change of the code).
+    """
     kind = overrides.get("controller.kind", "fxtntsmc (scenario)")
     rest = {k: v for k, v in overrides.items() if k not in ("controller.kind", "sim.duration")}
     what = f"SIMD batch of {batch}" if batch else "single run"
     extra = "".join(f", {k}={json.dumps(v)}" for k, v in sorted(rest.items()))
-    return f"{kind}, {overrides.get('sim.duration')} s, {what}{extra}"
+    extra += "".join(f", {t}: {k}={json.dumps(v)}" for t, o in zip("AB", per_tree) for k, v in sorted(o.items()))
+    return f"{kind}, {overrides.get('sim.duration')} s, {what}{extra}" + (", one tree" if one_tree else "")
 
 
 def section(key: str, res: dict, commits: tuple[str, str], runs: int) -> str:
@@ -193,7 +225,7 @@ def section(key: str, res: dict, commits: tuple[str, str], runs: int) -> str:
         *rows,
         "",
         f"Paired ratio B / A: median **{r2:.3f}**, quartiles {r1:.3f} and {r3:.3f}. "
-        f"Metrics bit-identical: {'yes' if res['identical'] else 'no'} ({res['metrics_note']}).",
+        f"Metrics: {res['metrics_note']}.",
         f"<!-- /ab: {key} -->",
     ])
 
@@ -201,11 +233,32 @@ def section(key: str, res: dict, commits: tuple[str, str], runs: int) -> str:
 def write_section(path: Path, key: str, text: str) -> None:
     """Put ``text`` in ``path``, replacing the section of the same ``key`` (or appending it)."""
     head = ("# Paired A/B timings (`benchmarks/ab.py`)\n\nWritten by `python benchmarks/ab.py A B`; one section per "
-            "configuration, the latest measurement of each. A is the base tree, B the change.\n")
+            "configuration, the latest measurement of each. A is the base tree, B the change; in a section marked "
+            "\"one tree\", A and B are the same tree and B differs only by the setting named (what that setting "
+            "costs).\n")
     old = path.read_text() if path.exists() else head
     pattern = re.compile(rf"<!-- ab: {re.escape(key)} -->.*?<!-- /ab: {re.escape(key)} -->", re.S)
     new = pattern.sub(lambda _m: text, old) if pattern.search(old) else old.rstrip("\n") + "\n\n" + text
     path.write_text(new.rstrip("\n") + "\n")
+
+
+def parse_overrides(items: list[str]) -> dict:
+    """``KEY=VALUE`` strings (VALUE in JSON) -> {key: value}.
+
+    Parameters
+    ----------
+    items : list of str
+        E.g. ``["metrics.path=false"]``.
+
+    Returns
+    -------
+    dict
+    """
+    out = {}
+    for item in items:
+        key, _, value = item.partition("=")
+        out[key] = json.loads(value)
+    return out
 
 
 def main() -> None:
@@ -219,24 +272,25 @@ def main() -> None:
     ap.add_argument("--duration", type=float, default=10.0, help="simulated seconds (default 10)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="scenario override (JSON value), e.g. --set controller.kind='\"ftsmc\"'")
+    ap.add_argument("--set-a", action="append", default=[], metavar="KEY=VALUE",
+                    help="scenario override for tree A only")
+    ap.add_argument("--set-b", action="append", default=[], metavar="KEY=VALUE",
+                    help="scenario override for tree B only (e.g. the same tree with metrics.path=false)")
     ap.add_argument("--out", type=Path, default=HERE / "ab.md", help="Markdown record (default benchmarks/ab.md)")
     args = ap.parse_args()
     if args.runs < 4:
         raise SystemExit("--runs: must be >= 4 (quartiles of the paired ratio)")
-    overrides = {"sim.duration": args.duration}
-    for item in args.set:
-        key, _, value = item.partition("=")
-        overrides[key] = json.loads(value)
-    res = measure(args.a, args.b, overrides, args.simd, args.runs)
+    overrides = {"sim.duration": args.duration, **parse_overrides(args.set)}
+    per_tree = (parse_overrides(args.set_a), parse_overrides(args.set_b))
+    res = measure(args.a, args.b, ({**overrides, **per_tree[0]}, {**overrides, **per_tree[1]}), args.simd, args.runs)
     what = f"batch of {args.simd}" if args.simd else "run"
     for name, t in zip(res["files"], res["times"]):
         q1, q2, q3 = quartiles([1e3 * x for x in t])
         print(f"{name}: median {q2:.2f} (quartiles {q1:.2f}, {q3:.2f}) ms per {what}")
     r1, r2, r3 = quartiles(res["ratio"])
     print(f"load average {res['load'][0]:.2f} -> {res['load'][1]:.2f}")
-    print(f"B / A: median {r2:.3f} (quartiles {r1:.3f}, {r3:.3f}); metrics bit-identical: {res['identical']} "
-          f"({res['metrics_note']})")
-    key = config_key(overrides, args.simd)
+    print(f"B / A: median {r2:.3f} (quartiles {r1:.3f}, {r3:.3f}); metrics: {res['metrics_note']}")
+    key = config_key(overrides, args.simd, per_tree, one_tree=args.a.resolve() == args.b.resolve())
     write_section(args.out, key, section(key, res, (commit_of(args.a), commit_of(args.b)), args.runs))
     print(f"recorded in {args.out}")
 
