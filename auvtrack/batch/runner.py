@@ -20,7 +20,6 @@ Two parallel back ends (measured in ``benchmarks/results.md``):
 from __future__ import annotations
 
 import math
-import os
 import threading
 import time
 import warnings
@@ -100,11 +99,8 @@ def preferred_backend(threads: str = "threads") -> str:
 
 
 def default_workers() -> int:
-    """Number of worker threads used when none is given: the number of usable cores."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not Linux
-        return max(1, os.cpu_count() or 1)
+    """Number of worker threads used when none is given: the usable cores (:func:`auvtrack.engine.kernels.usable_cores`)."""
+    return kernels.usable_cores()
 
 
 class StopSignal:

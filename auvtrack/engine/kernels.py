@@ -43,7 +43,7 @@ from ..user_modules import file_digest
 from ..user_modules import identifier as _ident
 from . import loop as engine
 
-__all__ = ["KernelKey", "kernel", "is_compiled", "warmup", "kernel_source", "compile_estimate"]
+__all__ = ["KernelKey", "kernel", "is_compiled", "warmup", "kernel_source", "compile_estimate", "usable_cores"]
 
 COMPILE_ESTIMATE_S = 20.0  # shown before the first compile of a kernel when nothing was measured yet
 
@@ -459,7 +459,7 @@ def warmup(keys: Iterable[KernelKey], *, jobs: int | None = None,
             per_key.append(cost)
     if not todo:
         return []
-    jobs = jobs or _cores()
+    jobs = jobs or usable_cores()
     waves = -(-len(todo) // max(1, jobs))
     say = notice or (lambda text: print(text, file=sys.stderr, flush=True))
     names = ", ".join(k.label or k.name for k in todo)
@@ -531,7 +531,14 @@ def _child_compile(keys: list[KernelKey], lanes: bool = False) -> None:
         print(key.name, flush=True)
 
 
-def _cores() -> int:
+def usable_cores() -> int:
+    """The number of cores this process may use: the default count of workers and compile jobs everywhere.
+
+    Returns
+    -------
+    int
+        ``len(os.sched_getaffinity(0))`` (``os.cpu_count()`` where that does not exist), at least 1.
+    """
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - not Linux
