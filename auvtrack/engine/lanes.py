@@ -681,6 +681,11 @@ def lane_version(disp):
         out = njit(cache=False, forceinline=bool(inline), **options)(ns[name])
         _CACHE[disp] = out
         _SOURCES[disp] = text
-        for cname, cdisp in callees.items():  # after our own entry: recursion terminates
-            ns[cname] = lane_version(cdisp)
+        try:
+            for cname, cdisp in callees.items():  # after our own entry: recursion terminates
+                ns[cname] = lane_version(cdisp)
+        except NotLaneable:  # a callee has no lane form, so neither has this function: not kept
+            _CACHE.pop(disp, None)
+            _SOURCES.pop(disp, None)
+            raise
         return out

@@ -11,7 +11,7 @@ from typing import Sequence
 from ..engine import kernels
 
 __all__ = ["builtin_controllers", "builtin_pairs", "kernel_keys", "compile_first", "ensure_compiled",
-           "warmup"]
+           "warmup", "lane_note"]
 
 
 def builtin_controllers(plant: str = "5dof") -> tuple[str, ...]:
@@ -136,3 +136,32 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     done = kernels.warmup(keys, progress=progress, lanes=simd)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
             "seconds": round(time.perf_counter() - t0, 2)}
+
+
+def lane_note(key: kernels.KernelKey) -> str | None:
+    """Whether a kernel's law and plant have a SIMD lane form, said at set-up (nothing is compiled).
+
+    The lane rewrite (:func:`auvtrack.engine.lanes.lane_version`) of the kernel's loop reads the
+    source of every function it calls; a construct outside the subset it handles (``try``,
+    iterating over a tuple, keyword arguments between compiled functions) means that the ``simd``
+    batch back end runs this pair on threads instead.
+
+    Parameters
+    ----------
+    key : auvtrack.engine.kernels.KernelKey
+        The pair.
+
+    Returns
+    -------
+    str or None
+        ``"<label>: no SIMD lane form (<why>); the simd batch back end runs it on threads"``, or
+        None when it has one.
+    """
+    from ..engine.lanes import NotLaneable, lane_version
+
+    try:
+        lane_version(kernels.kernel_module(key).run)
+    except NotLaneable as exc:
+        why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        return f"{key.label or key.name}: no SIMD lane form ({why}); the simd batch back end runs it on threads"
+    return None

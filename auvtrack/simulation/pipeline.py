@@ -40,6 +40,7 @@ from ..channels import BASE_CHANNELS, LOG_ROW, channel_names
 from ..engine.loop import ControllerBundle, EnvironmentBundle, Outputs, PlantBundle, Settings
 from ..plant.contract import SF
 from ..metrics import METRICS_SIZE, metrics_finalize, metrics_init
+from .compiling import lane_note
 from .result import Result
 
 STATE_NAMES = BASE_CHANNELS[LOG_ROW.eta:LOG_ROW.tau]  # eta and nu
@@ -182,6 +183,8 @@ def prepare(scenario: Scenario) -> Prepared:
         raise ValueError("sensor: noise needs sim.control_rate > 0")
     noise = noise_table(sc.seed, plan.control_samples if ctrl_every else 1, sigma)
     key = kernels.KernelKey(cc.law or cspec.module, plant_module, f"{cspec.name} on {plant_spec.name}")
+    plugins = [m for m in (key.law, key.plant) if not m.startswith("auvtrack.")]
+    lanes = lane_note(key) if plugins else None  # a plug-in outside the lane subset: said now, not mid-batch
     return Prepared(
         scenario=sc, key=key,
         plant=PlantBundle(_c(cpl.pp), _c(cpl.x0)),
@@ -191,7 +194,8 @@ def prepare(scenario: Scenario) -> Prepared:
         n_rows=plan.log_rows,
         channels=channels,
         notes=tuple(cpl.notes) + tuple(cc.notes) + tuple(n for n in [start_note(ref, p1, vp_nom[VP.ell])]
-                                                            if n and cspec.tracks),  # open loop: no tracking
+                                                            if n and cspec.tracks)  # open loop: no tracking
+        + ((f"{', '.join(plugins)}: {lanes}",) if lanes else ()),
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": {**cc.resolved, **design_record(sc)}},
         statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
