@@ -154,34 +154,36 @@ def measure(a: Path, b: Path, overrides: tuple[dict, dict], batch: int, runs: in
     for p in procs:
         p.stdin.close()
         p.wait()
-    common = sorted(set(metrics[0]) & set(metrics[1]))
-    differ = [k for k in common if not _same(metrics[0][k], metrics[1][k])]
-    only = [sorted(set(m) - set(common)) for m in metrics]
     return {"times": times, "ratio": [y / x for x, y in zip(*times)], "load": (load0, os.getloadavg()[0]),
-            "metrics_note": metrics_note(len(common), differ, only), "files": files}
+            "metrics_note": metrics_note(*metrics), "files": files}
 
 
-def metrics_note(n_common: int, differ: list[str], only: list[list[str]]) -> str:
-    """What the two trees' metrics have in common: a sentence for the report.
+def metrics_note(a: dict, b: dict) -> str:
+    """What the two trees' metrics have in common: a sentence for the report, counted from them.
 
     Parameters
     ----------
-    n_common : int
-        How many metrics both trees return.
-    differ : list of str
-        Those of them whose values are not bit-identical.
-    only : list of 2 lists of str
-        The metrics only tree A returns, and only tree B.
+    a, b : dict
+        The metrics of tree A's and tree B's first run (name -> value).
 
     Returns
     -------
     str
-        E.g. ``"the 33 metrics both trees return are bit-identical; only in B: xtrack_rmse"``.
+        E.g. ``"the 33 metrics both trees return are bit-identical; only in B: xtrack_rmse"``; a
+        metric NaN in one tree only (a metric that setting switches off) is counted apart.
     """
-    if differ:
-        note = f"of the {n_common} metrics both trees return, {len(differ)} differ: {', '.join(differ)}"
+    common = sorted(set(a) & set(b))
+    differ = [k for k in common if not _same(a[k], b[k])]
+    nan = {t: [k for k in differ if m[k] != m[k]] for t, m in zip("AB", (a, b))}
+    other = [k for k in differ if k not in nan["A"] + nan["B"]]
+    same = len(common) - len(differ)
+    if not differ:
+        note = f"the {len(common)} metrics both trees return are bit-identical"
     else:
-        note = f"the {n_common} metrics both trees return are bit-identical"
+        note = f"of the {len(common)} metrics both trees return, {same} are bit-identical"
+        note += "".join(f", {len(v)} NaN in {t} only ({', '.join(v)})" for t, v in nan.items() if v)
+        note += f", {len(other)} differ ({', '.join(other)})" if other else ""
+    only = [sorted(set(m) - set(common)) for m in (a, b)]
     return note + "".join(f"; only in {t}: {', '.join(o)}" for t, o in zip("AB", only) if o)
 
 
