@@ -225,7 +225,7 @@ def check_plugin_setups(suite, entries: Sequence) -> None:
 
     from ..scenario import load_scenario
     from ..simulation.pipeline import prepare
-    from ..simulation.probe import LawFault, probe
+    from ..simulation.probe import ProbeFault, probe
 
     for e in entries:
         if e.table.get("kind") != "plugin":
@@ -236,7 +236,7 @@ def check_plugin_setups(suite, entries: Sequence) -> None:
                 warnings.simplefilter("ignore")
                 prep = prepare(load_scenario(spec.raw, spec.overrides))
             probe(prep)
-        except LawFault as exc:
+        except ProbeFault as exc:
             where = str(exc).removeprefix("controller.module: ")
             raise CompareError(f"--plugin: {where}, on task {spec.task}, tier {spec.tier}") from None
         except PluginFailure as exc:

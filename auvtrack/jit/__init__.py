@@ -22,7 +22,7 @@ import types as pytypes
 from pathlib import Path
 
 import numba
-from numba.core import errors, types
+from numba.core import types
 from numba.core.registry import CPUDispatcher
 
 from . import lane_values as _lanes  # noqa: F401  (lane types registered before anything compiles)
@@ -94,12 +94,14 @@ class PlainArgsDispatcher(CPUDispatcher):
 
     def get_call_template(self, args, kws):
         """Resolve a call for the unliteral argument types (falling back to the literal ones)."""
+        from numba.core.errors import TypingError  # not ``errors``: the package's own ``errors`` module shadows it
+
         plain = tuple(types.unliteral(a) for a in args)
         plain_kws = {k: types.unliteral(v) for k, v in kws.items()}
         if plain != tuple(args) or plain_kws != kws:
             try:
                 return super().get_call_template(plain, plain_kws)
-            except errors.TypingError:
+            except TypingError:
                 pass
         return super().get_call_template(args, kws)
 
