@@ -121,37 +121,12 @@ def _read_source(source: Source) -> tuple[str, dict[str, Any]]:
             if str(exc).endswith(": file not found") and stem in available_scenarios():
                 raise ScenarioError(f"{exc} (a packaged scenario has that name: give the string {stem!r})") from None
             raise
-        other = _other_file_kind(data, os.fspath(source))
-        if other:
-            raise ScenarioError(f"{os.fspath(source)}: {other}")
         try:
             return os.fspath(source), anchor_vehicle_files(anchor_module(data, Path(path).parent), Path(path).parent)
         except ValueError as exc:  # a plug-in path that cannot be resolved
             raise ScenarioError(f"{os.fspath(source)}: {exc}") from None
     raise ScenarioError(f"scenario source must be a packaged scenario's name, a TOML file path, a dict or a "
                         f"Scenario (got {type(source).__name__})")
-
-
-def _other_file_kind(data: Mapping[str, Any], path: str) -> str:
-    """What to say about a TOML file that is a sweep's study file or a benchmark suite, not a scenario ("" otherwise).
-
-    A file is taken for one when it has keys a scenario does not and every one of its keys is a
-    key of that file kind (:class:`auvtrack.batch.sweep_spec.StudyFile`,
-    :class:`auvtrack.benchmark.suite.SuiteFile`).
-    """
-    from ..batch.sweep_spec import StudyFile
-    from ..benchmark.suite import SuiteFile
-
-    keys = set(data)
-    if not keys - set(Scenario.model_fields):
-        return ""
-    if keys <= set(StudyFile.model_fields):
-        return ("a sweep's study file (keys scenario, grid, random, ...), not a scenario: run it with "
-                f"`auvtrack sweep {path}` (docs/sweeps.md)")
-    if keys <= set(SuiteFile.model_fields):
-        return ("a benchmark suite (keys tasks, tiers, seeds, ...), not a scenario: run it with "
-                f"`auvtrack compare --suite {path}` (docs/benchmark.md)")
-    return ""
 
 
 @functools.lru_cache(maxsize=1)
