@@ -27,7 +27,7 @@ from ..engine import loop as engine
 from ..plant.contract import SF, with_sizes
 from ..user_modules import first_line, load_module
 
-__all__ = ["PROBE_S", "PROBE_MAX_STEPS", "PROBE_WALL_S", "ProbeFault", "LawFault", "PlantFault", "probe"]
+__all__ = ["PROBE_S", "PROBE_MAX_STEPS", "PROBE_WALL_S", "PROBE_ATTEMPTS", "ProbeFault", "LawFault", "PlantFault", "probe"]
 
 PROBE_S = 2.0
 """Simulated seconds of the probe run (fewer when the scenario is shorter)."""
@@ -36,6 +36,11 @@ PROBE_MAX_STEPS = 50_000
 PROBE_WALL_S = 60.0
 """Wall-clock seconds the probe run may take: a law still computing then (an endless loop) is refused;
 a probe that stopped at the request (a slow law) ends without a verdict."""
+
+
+PROBE_ATTEMPTS = 3
+"""Calls of the probe's kernel at most: one stopped at the wall time before its first step (still
+loading or compiling, the law not yet called) is made again."""
 
 
 class ProbeFault(ValueError):
@@ -98,11 +103,11 @@ def probe(prep, *, notice=None) -> None:
     def stop() -> None:
         out.info[engine.INFO_STOP] = 1
 
-    for _ in range(2):  # once more when the first call spent the wall time loading or compiling the kernel
-        take_fault()  # forget a fault of an earlier probe
-        loaded = bool(kernels.kernel(key).signatures)
+    for _ in range(PROBE_ATTEMPTS):  # again when a call was stopped before its first step (it spent the
+        take_fault()  # wall time loading or compiling the kernel); forget a fault of an earlier probe
         outcome = run_in_thread(lambda: call_kernel(short, out), stop, reraise=False, timeout=PROBE_WALL_S)
-        if loaded or not outcome.timed_out or outcome.abandoned or outcome.interrupted:
+        stepped = int(out.info[engine.INFO_STEPS]) > 0
+        if stepped or not outcome.timed_out or outcome.abandoned or outcome.interrupted:
             break
         out = outputs_for(short, rows=0)
     if outcome.interrupted:
