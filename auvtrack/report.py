@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
+from .report_figures import FIGURE_AREA_REM, make_readable
 from .simulation.result import to_jsonable
 
 __all__ = ["Report", "Block", "failure_cause", "fmt", "metrics_table", "markdown_table", "write_json",
@@ -407,7 +408,8 @@ class Report:
         """Save a Matplotlib figure as ``figures/<name>.png`` and add it.
 
         Build figures with :class:`matplotlib.figure.Figure` (no pyplot, no GUI backend); a
-        pyplot figure is closed after saving.
+        pyplot figure is closed after saving.  Its fonts are first scaled so that its smallest
+        text is readable in the HTML page's figure area (:func:`auvtrack.report_figures.make_readable`).
 
         Returns
         -------
@@ -416,13 +418,17 @@ class Report:
         """
         path = self.out / "figures" / f"{name}.png"
         path.parent.mkdir(parents=True, exist_ok=True)
+        text_px = make_readable(fig, dpi)
         fig.savefig(path, dpi=dpi, bbox_inches="tight")
         if "matplotlib.pyplot" in sys.modules:  # a pyplot-managed figure: release it
             sys.modules["matplotlib.pyplot"].close(fig)
-        return self.image(path, caption)
+        return self.image(path, caption, text_px)
 
-    def image(self, path: str | Path, caption: str = "") -> Path:
+    def image(self, path: str | Path, caption: str = "", text_px: float | None = None) -> Path:
         """Add a PNG file already written inside the report folder (e.g. by a worker process).
+
+        ``text_px`` is the height its smallest text is shown at in the HTML page
+        (:func:`auvtrack.report_figures.make_readable` returns it), recorded as ``data-text-px``.
 
         Returns
         -------
@@ -443,7 +449,8 @@ class Report:
         if png[:8] != b"\x89PNG\r\n\x1a\n":
             raise ValueError(f"figure {path} is not a PNG file")
         self.figures.append(path)
-        self.blocks.append(Block("figure", {"src": rel, "caption": caption, "name": path.stem, "png": png}))
+        self.blocks.append(Block("figure", {"src": rel, "caption": caption, "name": path.stem, "png": png,
+                                            "text_px": text_px}))
         return path
 
     def scenario(self, text: str | Mapping[str, Any], label: str) -> None:
@@ -488,7 +495,8 @@ class Report:
                           undefined=StrictUndefined, trim_blocks=True, lstrip_blocks=True)
         env.filters["inline"] = lambda s: Markup(inline_html(str(s)))
         env.filters["b64"] = lambda b: base64.b64encode(b).decode("ascii")
-        return env.get_template("report.html.j2").render(title=self.title, blocks=[*self.blocks, *self._closing()])
+        return env.get_template("report.html.j2").render(title=self.title, blocks=[*self.blocks, *self._closing()],
+                                                     figure_area_rem=FIGURE_AREA_REM)
 
     def write(self, name: str = "report.md", html: str | None = "report.html") -> Path:
         """Write ``<out>/<name>`` (Markdown) and ``<out>/<html>`` (HTML, unless None).

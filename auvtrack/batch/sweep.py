@@ -257,6 +257,10 @@ def run_sweep(study: str | Path | SweepSpec, out: str | Path, *, workers: int | 
     check_workers(workers, StudyError)
     parse_memory(memory_limit)
     cluster = None if client is not None or scheduler else (lambda: _client(workers, None, memory_limit))
+    if cluster is not None:  # local workers load the kernels from the disk cache: compile them here, visibly
+        from ..simulation.compiling import warmup
+
+        warmup(progress=progress)  # what each worker's warm-up loads (sweep_worker.worker_warmup)
     res = execute_chunks(SweepJob(spec), out, resume=resume, client=client, scheduler=scheduler,
                          start_cluster=cluster, max_chunks=max_chunks, progress=progress, on_chunk=on_chunk)
     summary = None

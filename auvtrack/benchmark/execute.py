@@ -200,11 +200,13 @@ def _prepare(spec: RunSpec):
 
 
 def check_plugin_setups(suite, entries: Sequence) -> None:
-    """Refuse a plug-in whose set-up breaks (raises anything but a refusal) on the comparison's first run.
+    """Refuse a plug-in whose set-up breaks, or whose law faults in its probe run, on the comparison's first run.
 
     The contract's way to refuse a run is a ``ValueError`` (a gain condition); such a run counts
     as a set-up failure.  Any other exception on the first (tier, task, seed 0) is a broken
-    plug-in, and the comparison stops before anything runs.
+    plug-in, and the comparison stops before anything runs.  That run's first seconds are then
+    flown with the law bounds-checked (:func:`auvtrack.simulation.probe.probe`, as ``check`` and
+    ``run`` do): a law that raises there (an index out of bounds) or never returns is refused.
 
     Parameters
     ----------
@@ -216,12 +218,14 @@ def check_plugin_setups(suite, entries: Sequence) -> None:
     Raises
     ------
     CompareError
-        One line naming ``--plugin``, the file and the exception.
+        One line naming ``--plugin``, the file and the exception (for a probe's fault: the file's
+        line, the error and the time).
     """
     import warnings
 
     from ..scenario import load_scenario
     from ..simulation.pipeline import prepare
+    from ..simulation.probe import ProbeFault, probe
 
     for e in entries:
         if e.table.get("kind") != "plugin":
@@ -230,7 +234,11 @@ def check_plugin_setups(suite, entries: Sequence) -> None:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                prepare(load_scenario(spec.raw, spec.overrides))
+                prep = prepare(load_scenario(spec.raw, spec.overrides))
+            probe(prep)
+        except ProbeFault as exc:
+            where = str(exc).removeprefix("controller.module: ")
+            raise CompareError(f"--plugin: {where}, on task {spec.task}, tier {spec.tier}") from None
         except PluginFailure as exc:
             raise CompareError(f"--plugin: {e.table.get('module')}: its set-up fails on task {spec.task}, tier "
                                f"{spec.tier}: {exc.cause}") from None

@@ -30,10 +30,45 @@ class BadInput(click.ClickException):
 
 
 def load_arg(scenario: str, overrides: tuple[str, ...]):
-    """The validated scenario of a command's SCENARIO argument (a file or a packaged name) and its --set."""
-    from ..scenario import load_scenario
+    """The validated scenario of a command's SCENARIO argument (a file or a packaged name) and its --set.
 
-    return load_scenario(scenario, list(overrides))
+    A sweep's study file or a benchmark suite given instead is named as such, with the command that runs it.
+    """
+    from ..scenario import ScenarioError, load_scenario
+
+    try:
+        return load_scenario(scenario, list(overrides))
+    except ScenarioError:
+        other = _other_file_kind(scenario)
+        if other:
+            raise ScenarioError(f"{scenario}: {other}") from None
+        raise
+
+
+def _other_file_kind(path: str) -> str:
+    """What to say about a TOML file that is a sweep's study file or a benchmark suite, not a scenario ("" otherwise).
+
+    A file is taken for one when it has keys a scenario does not and every one of its keys is a
+    key of that file kind (:class:`auvtrack.batch.sweep_spec.StudyFile`,
+    :class:`auvtrack.benchmark.suite.SuiteFile`).
+    """
+    from ..batch.sweep_spec import StudyFile
+    from ..benchmark.suite import SuiteFile
+    from ..scenario import Scenario, ScenarioError, read_toml
+
+    try:
+        keys = set(read_toml(path)) if path.endswith(".toml") else set()
+    except ScenarioError:
+        return ""
+    if not keys - set(Scenario.model_fields):
+        return ""
+    if keys <= set(StudyFile.model_fields):
+        return ("a sweep's study file (keys scenario, grid, random, ...), not a scenario: run it with "
+                f"`auvtrack sweep {path}` (docs/sweeps.md)")
+    if keys <= set(SuiteFile.model_fields):
+        return ("a benchmark suite (keys tasks, tiers, seeds, ...), not a scenario: run it with "
+                f"`auvtrack compare --suite {path}` (docs/benchmark.md)")
+    return ""
 
 
 def prepare_arg(scenario: str, sc):

@@ -114,10 +114,12 @@ def bench(controllers: tuple[str, ...], repeat: int, duration: float, run_all: b
     from ..simulation.compiling import builtin_controllers
 
     if plant != "5dof":  # the 6-DOF truths, one line per (controller, preset)
-        for row in bench_plant(controllers or ("ftsmc", "fxtntsmc"), plant, repeat=repeat, duration=duration):
+        for row in bench_plant(controllers or ("ftsmc", "fxtntsmc"), plant, repeat=repeat, duration=duration,
+                               progress=True):
             click.echo(json.dumps(row))
         return
-    for row in bench_singles(controllers or builtin_controllers(), repeat=repeat, duration=duration):
+    for row in bench_singles(controllers or builtin_controllers(), repeat=repeat, duration=duration,
+                             progress=True):
         click.echo(json.dumps(row))
 
 

@@ -6,9 +6,10 @@ from pathlib import Path
 
 import click
 
+from ..simulation.manoeuvre import manoeuvre_line
 from .common import (EXIT_CODES_HELP, EXIT_INTERRUPTED, EXIT_SIM_FAILED, LONG_RUN_STEPS, BadInput, cli, load_arg, mib,
                      one_line, prepare_arg, set_option)
-from .digest import manoeuvre_line, manoeuvre_metrics, saturation_warning
+from .digest import saturation_warning
 from .signals import stop_requests
 
 
@@ -62,9 +63,7 @@ def run(scenario: str, out: str | None, overrides: tuple[str, ...], mat: bool) -
     except SimulationInterrupted as exc:  # stopped within about a second; write what was computed
         res = exc.result
     tracks = spec_for(sc.controller).tracks
-    manoeuvre = None if tracks else manoeuvre_metrics(res, sc.controller)
-    if manoeuvre is not None:  # an open-loop run: its manoeuvre, not a tracking error, is the result
-        res.meta["manoeuvre"] = manoeuvre
+    manoeuvre = res.meta.get("manoeuvre")  # an open-loop run: its manoeuvre, not a tracking error, is the result
     try:  # Ctrl-C while the folder is written: keep the rows written so far, publish, exit 130
         with stop_requests() as requested:
             folder = res.save(target, mat=mat or sc.output.mat, overwrite=out is not None, stop=requested)

@@ -62,7 +62,9 @@ class KernelKey:
         Human name for messages, e.g. ``"fxtntsmc on 5dof"``.
     checked : bool
         The law compiled with bounds checking, an exception it raises turned into a status
-        (:func:`auvtrack.control.plugin.bounds_checked`): the kernel of a plug-in's probe run.
+        (:func:`auvtrack.control.plugin.bounds_checked`), and a plant that is not built in
+        bounds-checked too (:func:`auvtrack.plant.checked.bounds_checked_plant`): the kernel of a
+        plug-in's probe run.
     """
 
     law: str
@@ -136,6 +138,9 @@ from auvtrack.user_modules import load_module
 plant = with_sizes(load_module({key.plant!r}))
 law = {bind.format(key=key)}
 '''
+    if key.checked and not key.plant.startswith("auvtrack."):  # a plug-in plant's functions, bounds-checked too
+        head += ("from auvtrack.plant.checked import bounds_checked_plant  # noqa: E402\n"
+                 "plant = bounds_checked_plant(plant)\n")
     tail = "\n\nlog_row.lane_stub = True  # the SIMD batch kernels keep no trajectory (metrics only)\n"
     return head + "\n\n" + "\n\n".join(parts) + tail
 
@@ -509,7 +514,7 @@ def _shares(keys: list[KernelKey], jobs: int) -> list[list[KernelKey]]:
 def _compile_in_child(keys: list[KernelKey], bar, lanes: bool = False, children: list | None = None) -> None:
     code = ("import sys, json; from auvtrack.engine.kernels import KernelKey, _child_compile; "
             "_child_compile([KernelKey(**k) for k in json.loads(sys.argv[1])], sys.argv[2] == '1')")
-    arg = json.dumps([{"law": k.law, "plant": k.plant, "label": k.label} for k in keys])
+    arg = json.dumps([{"law": k.law, "plant": k.plant, "label": k.label, "checked": k.checked} for k in keys])
     with tempfile.TemporaryFile("w+") as errf, subprocess.Popen(
             [sys.executable, "-c", code, arg, "1" if lanes else "0"], stdout=subprocess.PIPE, stderr=errf,
             text=True) as proc:

@@ -27,7 +27,7 @@ class CompileError(ValueError):
         self.details = details
 
 
-_LOCATION = re.compile(r'File "([^"]+)", line (\d+)')
+_LOCATION = re.compile(r'File "(.+?)", line (\d+)')  # a path may hold quotes
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")  # Numba's highlighting (its colour scheme may be on)
 _NOISE = ("Failed in ", "During:", "File ", "Enable logging", "This error may have been", "Traceback",
           "numba.core.errors", "raise ", "^", "Exception", "<source", "    ")

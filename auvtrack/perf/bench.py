@@ -110,7 +110,8 @@ def bench_single(kind: str, *, repeat: int = 7, duration: float = 20.0) -> dict:
     return bench_singles((kind,), repeat=repeat, duration=duration)[0]
 
 
-def bench_plant(kinds: tuple[str, ...], plant: str, *, repeat: int = 7, duration: float = 20.0) -> list[dict]:
+def bench_plant(kinds: tuple[str, ...], plant: str, *, repeat: int = 7, duration: float = 20.0,
+                progress: bool = False) -> list[dict]:
     """:func:`bench_singles` on a plant model: ``"5dof"`` (Section 4) or ``"6dof"`` (each preset).
 
     Returns
@@ -120,21 +121,24 @@ def bench_plant(kinds: tuple[str, ...], plant: str, *, repeat: int = 7, duration
     """
     rows = []
     for source, extra in PLANT_BENCH[plant]:
-        for r in bench_singles(kinds, repeat=repeat, duration=duration, source=source, extra=extra):
+        for r in bench_singles(kinds, repeat=repeat, duration=duration, source=source, extra=extra, progress=progress):
             rows.append({"plant": plant, **({"preset": extra[1].split("=", 1)[1]} if extra else {}), **r})
     return rows
 
 
 def bench_singles(kinds: tuple[str, ...], *, repeat: int = 7, duration: float = 20.0, source=PAPER,
-                  extra: tuple[str, ...] = ()) -> list[dict]:
+                  extra: tuple[str, ...] = (), progress: bool = False) -> list[dict]:
     """:func:`bench_single` for several controllers (``plugin:<file>`` for a plug-in), their repetitions interleaved.
 
     Round-robin timing: on a shared machine whose speed drifts for seconds at a time, a slow
     spell then lands on every controller alike instead of on one, so the ratios stay meaningful.
+    The kernels missing from the cache compile first, in parallel (``progress``: with a bar).
     """
+    from ..simulation.compiling import ensure_compiled
     from ..simulation.pipeline import run_prepared
 
     preps = {k: _prepared(k, duration, source, extra) for k in kinds}
+    ensure_compiled(list(preps.values()), progress=progress)
     status = {k: run_prepared(p).status for k, p in preps.items()}  # compile or load from cache
     wall: dict[str, list[float]] = {k: [] for k in kinds}
     cpu: dict[str, list[float]] = {k: [] for k in kinds}

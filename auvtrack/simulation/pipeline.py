@@ -84,6 +84,9 @@ class Prepared:
         Derived values recorded in ``run.json``.
     statuses : dict of int to str
         Messages of the controller's status codes.
+    tracks : bool
+        Whether the controller tracks a reference (else its result carries the manoeuvre it flew,
+        :mod:`auvtrack.simulation.manoeuvre`).
     """
 
     scenario: Scenario
@@ -98,6 +101,7 @@ class Prepared:
     notes: tuple[str, ...]
     resolved: dict
     statuses: dict
+    tracks: bool = True
 
     # short names for the most used arrays
     si = property(lambda self: self.settings.si, doc="Integer settings (layout :data:`auvtrack.engine.loop.SI`).")
@@ -199,6 +203,7 @@ def prepare(scenario: Scenario) -> Prepared:
         resolved={"vehicle": cpl.resolved.get("vehicle", {}), "plant": cpl.resolved,
                   "controller": {**cc.resolved, **design_record(sc)}},
         statuses={**CONTROLLER_STATUS, **cspec.statuses, **cc.statuses},
+        tracks=cspec.tracks,
     )
 
 
@@ -302,7 +307,8 @@ def _partial(prep: Prepared, out: Outputs, wall: float, cause: str, detail: str)
     metrics = metrics_finalize(out.acc, t0, min(t1, t))
     meta = {"version": __version__, "wall_time_s": wall, "notes": list(prep.notes), "steps": steps,
             "steps_planned": prep.n_steps}
-    return Result(channels, resolved, "interrupted" if cause == "interrupted" else "failed", failure, metrics, meta)
+    return _with_manoeuvre(prep, Result(channels, resolved, "interrupted" if cause == "interrupted" else "failed",
+                                        failure, metrics, meta))
 
 
 def result_from(prep: Prepared, out: Outputs, cause: int, rows: int, t_stop: float, wall: float) -> Result:
@@ -317,7 +323,16 @@ def result_from(prep: Prepared, out: Outputs, cause: int, rows: int, t_stop: flo
     resolved["resolved"] = prep.resolved
     meta = {"version": __version__, "wall_time_s": wall, "notes": list(prep.notes),
             "steps": int(out.info[engine.INFO_STEPS]), "steps_planned": prep.n_steps}
-    return Result(channels, resolved, status_of(cause), failure, metrics, meta)
+    return _with_manoeuvre(prep, Result(channels, resolved, status_of(cause), failure, metrics, meta))
+
+
+def _with_manoeuvre(prep: Prepared, result: Result) -> Result:
+    """``result``, with ``meta["manoeuvre"]`` (the figures, or None when none was flown) for a controller that does not track."""
+    if not prep.tracks:
+        from .manoeuvre import manoeuvre_metrics
+
+        result.meta["manoeuvre"] = manoeuvre_metrics(result, prep.scenario.controller)
+    return result
 
 
 def status_of(cause: int) -> str:

@@ -1,4 +1,4 @@
-"""The probe run of a plug-in law: its first seconds with bounds checking on, before the run.
+"""The probe run of a plug-in law or plant: its first seconds with bounds checking on, before the run.
 
 A plug-in's law that writes past an array's end (``out.u[100000] = ...``) corrupts memory in the
 compiled loop without a message, and the process may die at exit with a segmentation fault.
@@ -8,8 +8,10 @@ bounds checking (:func:`auvtrack.control.plugin.bounds_checked`, kernel
 refused with one line naming the time and, found by calling the law once more as plain Python
 at the state where it raised, the plug-in's file, line and the error.  ``auvtrack check`` and
 ``auvtrack run`` (and :func:`auvtrack.simulate`) both probe, so ``check`` refuses what ``run``
-would.  A fault that first happens later than the probe's horizon, or inside a compiled helper
-the law calls, is not seen.
+would.  A plug-in plant's compiled functions are bounds-checked in the same run
+(:func:`auvtrack.plant.checked.bounds_checked_plant`): one that raises there is refused with
+its file, line, function and error.  A fault that first happens later than the probe's horizon,
+or inside a compiled helper the law or plant calls, is not seen.
 """
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ from ..engine import loop as engine
 from ..plant.contract import SF, with_sizes
 from ..user_modules import first_line, load_module
 
-__all__ = ["PROBE_S", "PROBE_MAX_STEPS", "PROBE_WALL_S", "LawFault", "probe"]
+__all__ = ["PROBE_S", "PROBE_MAX_STEPS", "PROBE_WALL_S", "PROBE_ATTEMPTS", "ProbeFault", "LawFault", "PlantFault", "probe"]
 
 PROBE_S = 2.0
 """Simulated seconds of the probe run (fewer when the scenario is shorter)."""
@@ -36,22 +38,39 @@ PROBE_WALL_S = 60.0
 a probe that stopped at the request (a slow law) ends without a verdict."""
 
 
-class LawFault(ValueError):
-    """A plug-in's law raised in the probe run (bounds checking on): one line naming where."""
+PROBE_ATTEMPTS = 3
+"""Calls of the probe's kernel at most: one stopped at the wall time before its first step (still
+loading or compiling, the law not yet called) is made again."""
 
 
-def _is_plugin(prep) -> bool:
+class ProbeFault(ValueError):
+    """A plug-in raised in the probe run (bounds checking on): one line naming where."""
+
+
+class LawFault(ProbeFault):
+    """A plug-in's law raised in the probe run (or never returned there)."""
+
+
+class PlantFault(ProbeFault):
+    """A plug-in plant's compiled function raised in the probe run."""
+
+
+def _plugin_law(prep) -> bool:
     return getattr(prep.scenario.controller, "kind", None) == "plugin"
 
 
+def _plugin_plant(prep) -> bool:
+    return not prep.key.plant.startswith("auvtrack.")
+
+
 def probe(prep, *, notice=None) -> None:
-    """Run the first seconds of ``prep`` with its plug-in law bounds-checked; refuse a law that raises.
+    """Run the first seconds of ``prep`` with its plug-in law and plant bounds-checked; refuse one that raises.
 
     Parameters
     ----------
     prep : Prepared
         A prepared run (:func:`auvtrack.simulation.pipeline.prepare`); nothing is done unless its
-        controller is a plug-in.
+        controller or its plant is a plug-in.
     notice : callable, optional
         Receives the "compiling kernels" notice of the probe's kernel (default: printed to stderr).
 
@@ -60,13 +79,16 @@ def probe(prep, *, notice=None) -> None:
     LawFault
         ``controller.module: <file>:<line>: control raised IndexError: ... at t = ... s (bounds-checked
         probe run)``.
+    PlantFault
+        ``plant.module: <file>:<line>: rhs raised IndexError: ... in the step from t = ... s (...)``.
     KeyboardInterrupt
         On Ctrl-C while the probe runs.
     """
-    if not _is_plugin(prep):
+    if not (_plugin_law(prep) or _plugin_plant(prep)):
         return
     from ..control.plugin import STATUS_RAISED
     from ..interrupt import run_in_thread
+    from ..plant.checked import take_fault
     from .pipeline import call_kernel, outputs_for
 
     dt = float(prep.sf[SF.dt])
@@ -81,10 +103,11 @@ def probe(prep, *, notice=None) -> None:
     def stop() -> None:
         out.info[engine.INFO_STOP] = 1
 
-    for _ in range(2):  # once more when the first call spent the wall time loading or compiling the kernel
-        loaded = bool(kernels.kernel(key).signatures)
+    for _ in range(PROBE_ATTEMPTS):  # again when a call was stopped before its first step (it spent the
+        take_fault()  # wall time loading or compiling the kernel); forget a fault of an earlier probe
         outcome = run_in_thread(lambda: call_kernel(short, out), stop, reraise=False, timeout=PROBE_WALL_S)
-        if loaded or not outcome.timed_out or outcome.abandoned or outcome.interrupted:
+        stepped = int(out.info[engine.INFO_STEPS]) > 0
+        if stepped or not outcome.timed_out or outcome.abandoned or outcome.interrupted:
             break
         out = outputs_for(short, rows=0)
     if outcome.interrupted:
@@ -95,7 +118,12 @@ def probe(prep, *, notice=None) -> None:
     if outcome.timed_out:
         return  # a slow law: stopped at the request, nothing wrong seen
     if isinstance(outcome.value, BaseException) or outcome.value is None:
-        return  # a plant that raised: the run reports it with its partial result
+        fault = take_fault()
+        if fault is not None:  # a plug-in plant's function raised with bounds checking on
+            t = int(out.info[engine.INFO_STEPS]) * dt
+            raise PlantFault(f"plant.module: {fault} in the step from t = {t:.6g} s (bounds-checked probe run of "
+                             f"the first {steps * dt:.6g} s)")
+        return  # a plant that raised otherwise: the run reports it with its partial result
     cause, _, t = outcome.value
     if cause != engine.CAUSE_CONTROLLER or int(out.info[engine.INFO_STATUS]) != STATUS_RAISED:
         return  # ran, or stopped for a reason the run itself reports

@@ -424,8 +424,27 @@ class Result:
         """Number of samples."""
         return int(self.t.size)
 
+    @property
+    def tracks(self) -> bool:
+        """Whether the run's controller tracks a reference (an open-loop run flies a manoeuvre instead).
+
+        An open-loop result carries ``meta["manoeuvre"]``; a result without it is asked of the
+        controller's registered record (a plug-in's or an unknown kind counts as tracking).
+        """
+        if "manoeuvre" in self.meta:
+            return False
+        ctrl = self.scenario.get("controller") if isinstance(self.scenario, Mapping) else None
+        kind = ctrl.get("kind") if isinstance(ctrl, Mapping) else None
+        from ..control import get
+
+        try:
+            return bool(get(kind).tracks) if isinstance(kind, str) and kind != "plugin" else True
+        except (KeyError, ValueError):
+            return True
+
     def __repr__(self) -> str:
-        """Short summary: status, controller, time span, key metrics."""
+        """Short summary: status, controller, time span, key metrics (an open-loop run: its manoeuvre, no tracking error)."""
+        from .manoeuvre import manoeuvre_line
         from .plotting import run_label
 
         t = self.t
@@ -435,7 +454,10 @@ class Result:
             parts[0] += f" at t={self.failure.get('time', math.nan):.6g} s ({self.failure.get('cause')})"
         parts += [f"controller={run_label(self)!r}", f"{span}, {t.size} samples, {len(self._ch)} channels"]
         m = self.metrics
-        if all(f"rmse_{a}" in m for a in "xyz"):
+        if not self.tracks:
+            flown = self.meta.get("manoeuvre")
+            parts.append(manoeuvre_line(flown) if flown else "open loop (no manoeuvre recognised)")
+        elif all(f"rmse_{a}" in m for a in "xyz"):
             parts.append("rmse[m]=(" + ", ".join(f"{a} {m[f'rmse_{a}']:.3g}" for a in "xyz") + ")")
         if all(f"max_abs_tau_{j}" in m for j in "uqr"):
             parts.append("max|tau|=(" + ", ".join(f"{j} {m[f'max_abs_tau_{j}']:.3g}" for j in "uqr") + ")")

@@ -33,12 +33,15 @@ from ..simulation.result import Result
 from ..scenario import load_scenario
 from ..scenario import paper_scenario_path
 from ..report import Report, metric_unit
+from ..report_figures import make_readable
 
 CONTROLLERS = (("FXTNTSMC", "fxtntsmc"), ("FTSMC", "ftsmc"))
 # the same comparison with both controllers tuned by one procedure (docs/tuning.md)
 TUNED_PRESETS = {"fxtntsmc": "fxtntsmc_tuned", "ftsmc": "ftsmc_tuned"}
 AXES = ("x", "y", "z")
 INPUTS = ("u", "q", "r")
+FIGURE_DPI = 200
+"""Resolution of the paper figures' PNG files (their PDFs are vector)."""
 FIGURES = (
     ("fig3_trajectory3d", plotting.fig_trajectory3d),
     ("fig4_positions", plotting.fig_positions),
@@ -145,12 +148,14 @@ def preset_overrides(name: str) -> list[str]:
     return [f"controller.{k}={v!r}" for k, v in get_gain_preset(name).gains.items()]
 
 
-def _render(job: tuple[str, list, Path, dict]) -> str:
-    """Draw and save one figure (runs in a worker process)."""
+def _render(job: tuple[str, list, Path, dict]) -> tuple[str, float]:
+    """Draw and save one figure (runs in a worker process); return its name and its smallest text's shown size (px)."""
     name, pairs, fig_dir, kw = job
     fn = dict(FIGURES)[name]
-    plotting.save_figure(fn(pairs, **kw), fig_dir / name)
-    return name
+    fig = fn(pairs, **kw)
+    text_px = make_readable(fig, FIGURE_DPI)
+    plotting.save_figure(fig, fig_dir / name, dpi=FIGURE_DPI)
+    return name, text_px
 
 
 def _compare(claim: str, metric: str, names, a: dict, b: dict, unit: str) -> Verdict:
@@ -296,8 +301,9 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     pairs = list(runs.items())
     kw = {"fig6_inputs": {"steady_from": window[0]}}
     jobs = [(name, pairs, out / "figures", kw.get(name, {})) for name, _ in FIGURES]
+    text_px = {}
     with ProcessPoolExecutor(max_workers=default_workers()) as pool:  # figures are independent: one per core
-        for name in pool.map(_render, jobs):
+        for name, text_px[name] in pool.map(_render, jobs):
             bar.set_postfix_str(name)
             bar.update()
     bar.close()
@@ -312,7 +318,7 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     rep = _report(out, runs, full, steady, vs, window)
     _tuned_report(rep, tuned, vs_tuned)
     _forms_report(rep, forms)
-    _figures(rep, runs, window)
+    _figures(rep, runs, window, text_px)
     for label, r in runs.items():
         rep.scenario(_shown_scenario(r), f"Scenario of the {label} run (resolved; run folder `{r.scenario['controller']['kind']}/`)")
     rep.write("summary.md", html="report.html")
@@ -372,10 +378,10 @@ def _report(out: Path, runs, full, steady, vs, window) -> Report:
     return rep
 
 
-def _figures(rep: Report, runs: dict[str, Result], window: tuple[float, float]) -> None:
+def _figures(rep: Report, runs: dict[str, Result], window: tuple[float, float], text_px: dict[str, float]) -> None:
     rep.heading("Figures")
     rep.paragraph("Files: `figures/fig3_trajectory3d` … `figures/fig8_chi` (PNG and PDF).")
     ell = plotting.lever_arm(next(iter(runs.values())))
     for name, _ in FIGURES:
         rep.image(rep.out / "figures" / f"{name}.png",
-                  CAPTIONS[name].format(ell="?" if ell is None else f"{ell:g} m", t_ss=window[0]))
+                  CAPTIONS[name].format(ell="?" if ell is None else f"{ell:g} m", t_ss=window[0]), text_px[name])

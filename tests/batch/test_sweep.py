@@ -301,3 +301,31 @@ def test_sweep_survives_samples_over_the_memory_limit(tmp_path):
         res = run_prepared(prepare(load_scenario(spec.base, spec.overrides(i)[1])))
         np.testing.assert_array_equal(df.loc[i, list(METRIC_NAMES)].to_numpy(float),
                                       np.array([res.metrics[m] for m in METRIC_NAMES]))
+
+
+def test_a_local_sweep_compiles_its_kernels_in_the_client_with_a_progress_bar(tmp_path, monkeypatch):
+    """The workers of a local cluster only load kernels from the disk cache when the client compiled
+    them first, with its "compiling kernels" notice and (with progress) a bar; nothing is compiled
+    here for a scheduler the caller gives (its workers may be other machines)."""
+    from auvtrack.batch import sweep as sweep_module
+    from auvtrack.simulation import compiling
+
+    calls = []
+
+    class Stop(Exception):
+        pass
+
+    def fake_warmup(*args, **kw):
+        calls.append(kw)
+        raise Stop
+
+    monkeypatch.setattr(compiling, "warmup", fake_warmup)
+    monkeypatch.setattr(sweep_module, "_client", lambda *a, **k: (_ for _ in ()).throw(AssertionError("cluster first")))
+    example = Path(__file__).resolve().parents[2] / "scenarios" / "sweep_example.toml"
+    with pytest.raises(Stop):
+        sweep_module.run_sweep(example, tmp_path / "out", workers=1, progress=True)
+    assert calls == [{"progress": True}]
+    monkeypatch.setattr(sweep_module, "execute_chunks", lambda *a, **k: (_ for _ in ()).throw(Stop()))
+    with pytest.raises(Stop):
+        sweep_module.run_sweep(example, tmp_path / "out2", scheduler="tcp://127.0.0.1:1", progress=True)
+    assert len(calls) == 1

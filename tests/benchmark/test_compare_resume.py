@@ -180,6 +180,26 @@ def test_a_plugin_whose_setup_breaks_is_refused_before_anything_runs(tmp_path, c
     assert not (tmp_path / "x").exists()
 
 
+def test_a_plugin_writing_out_of_bounds_is_refused_by_its_probe_before_anything_runs(tmp_path, capsys):
+    """compare probes the plug-in's law on its first run as check and run do: the index error, its file
+    and line, the time and the task are named in one line, exit 2, and no folder is written."""
+    law = PLUGIN.read_text()
+    body = "    out.aux[0], out.aux[1], out.aux[2] = a\n    return 0\n"
+    assert law.count(body) == 1
+    bad = tmp_path / "oob_law.py"
+    bad.write_text(law.replace(body, "    out.aux[0], out.aux[1], out.aux[2] = a\n    if t > 0.5:\n"
+                                     "        out.u[100000] = 1.0\n    return 0\n"))
+    line = bad.read_text().splitlines().index("        out.u[100000] = 1.0") + 1
+    code = main(["compare", "--suite", str(_suite(tmp_path)), "--quick", "--controllers", "ftsmc", "--plugin", str(bad),
+                 "--out", str(tmp_path / "x"), "--quiet"])
+    err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("compiling kernels")]
+    assert code == EXIT_BAD_INPUT and len(err) == 1 and "Traceback" not in err[0], err
+    assert err[0].startswith(f"auvtrack: error: --plugin: {bad}:{line}: control raised IndexError: index 100000 is "
+                             "out of bounds"), err
+    assert "in the step from t = 0.5" in err[0] and err[0].endswith("on task helix, tier calm"), err
+    assert not (tmp_path / "x").exists()
+
+
 def test_a_plugin_s_exception_in_a_run_is_that_run_s_setup_failure(tmp_path):
     broken = tmp_path / "broken_setup.py"
     broken.write_text(PLUGIN.read_text() + "\n\ndef setup(params, ctx):\n    raise KeyError('gains')\n")

@@ -100,3 +100,23 @@ def test_result_save_documents_folder_error():
     assert "FolderError" in Result.save.__doc__
     doc = (ROOT / "docs" / "metrics.md").read_text()
     assert "`auvtrack.simulation.result.FolderError`" in doc
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+@pytest.mark.parametrize("path, points_to", [
+    (ROOT / "scenarios" / "sweep_example.toml", "a sweep's study file (keys scenario, grid, random, ...), not a "
+                                                "scenario: run it with `auvtrack sweep {path}` (docs/sweeps.md)"),
+    (ROOT / "auvtrack" / "data" / "benchmarks" / "auv-track-v2.toml",
+     "a benchmark suite (keys tasks, tiers, seeds, ...), not a scenario: run it with `auvtrack compare --suite {path}` (docs/benchmark.md)"),
+])
+def test_a_sweep_or_suite_file_given_as_a_scenario_names_its_command(capsys, monkeypatch, command, path, points_to):
+    _nothing_runs(monkeypatch)
+    assert _one_line(capsys, [command, str(path)]) == f"{path}: " + points_to.format(path=path)
+
+
+def test_a_scenario_with_one_sweep_key_is_still_a_scenario_error(tmp_path, capsys, monkeypatch):
+    """Only a file whose every key is a study file's is called one: a scenario with a stray key keeps its message."""
+    _nothing_runs(monkeypatch)
+    path = tmp_path / "sc.toml"
+    path.write_text('name = "x"\nsamples = 3\n[sim]\nduration = 1.0\n')
+    assert _one_line(capsys, ["check", str(path)]).startswith(f"{path}: samples: unknown key (allowed: name, ")

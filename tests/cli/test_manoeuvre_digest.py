@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from auvtrack.channels import BASE_CHANNELS
-from auvtrack.cli.digest import manoeuvre_line, manoeuvre_metrics
+from auvtrack.simulation.manoeuvre import manoeuvre_line, manoeuvre_metrics
 from auvtrack.simulation.result import Result
 
 R, U, T0 = 40.0, 1.5, 5.0

@@ -14,7 +14,6 @@ import pandas as pd
 import pytest
 from scipy.linalg import expm
 
-import auvtrack
 from auvtrack.cli import EXIT_BAD_INPUT, main
 from auvtrack.control.tracking import error_state
 from auvtrack.vehicle.kinematics import attitude
@@ -196,3 +195,41 @@ def test_a_path_given_outside_a_file_is_relative_to_the_current_folder(outside, 
     sc = load_scenario(paper_scenario_path(), ["controller={kind=\"plugin\", module=\"my_pd.py\"}"])
     assert sc.controller.module == str((outside / "my_pd.py").resolve())
     assert load_scenario(sc.to_dict()) == sc  # the resolved scenario names the file absolutely
+
+
+HOSTILE = 'we\\Nird """ dir'  # a backslash sequence and a triple quote: legal in a file name
+
+
+@pytest.mark.parametrize("change, expected", [
+    (None, None),  # runs: nothing the user named reaches generated code unescaped
+    (("\nSTATUS = None\n",), r"controller\.module: .*status_none\.py: STATUS must map codes 10 \.\. 2\*\*31 - 1 to "
+                             r"messages \(got None\)"),
+    (("    out.aux[0], out.aux[1], out.aux[2] = a\n", "    out.aux[0], out.aux[1], out.aux[2] = a\n    z = a[5]\n"),
+     r"controller\.module: .*typing_error\.py: cannot compile: .*typing_error\.py:(?P<line>\d+): tuple index out of "
+     r"range"),
+], ids=["runs", "status_none", "typing_error"])
+def test_a_plugin_in_a_folder_with_a_hostile_name(tmp_path, capsys, change, expected):
+    """Loaded by module spec, named by repr in generated code: such a folder runs the law (check and run)
+    or refuses it in one line naming the file and, for a compile error, the line of the cause."""
+    folder = tmp_path / HOSTILE
+    folder.mkdir()
+    name = "law.py" if change is None else ("status_none.py" if len(change) == 1 else "typing_error.py")
+    text = EXAMPLE.read_text()
+    if change is not None:
+        text = text + change[0] if len(change) == 1 else text.replace(*change)
+    (folder / name).write_text(text)
+    sc = _scenario(folder, name, extra="[sim]\nduration = 1.0")
+    if expected is None:
+        assert main(["check", str(sc)]) == 0
+        assert main(["run", str(sc), "--out", str(tmp_path / "run")]) == 0
+        assert (tmp_path / "run" / "trajectory.csv").is_file()
+        return
+    for args in (["check", str(sc)], ["run", str(sc), "--out", str(tmp_path / "run")]):
+        assert main(args) == EXIT_BAD_INPUT
+        err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("compiling kernels")]
+        assert len(err) == 1 and "Traceback" not in err[0], err
+        m = re.search(expected, err[0])
+        assert m, err[0]
+        if "line" in m.groupdict():
+            assert text.splitlines()[int(m["line"]) - 1].strip() == "z = a[5]"
+    assert not (tmp_path / "run").exists()

@@ -116,3 +116,41 @@ def test_compile_error_line_reads_a_highlighted_report(tmp_path):
               f'\x1b[1m\nFile "{user}", line 7:\x1b[0m\n')
     assert compile_error_line(report, "k") == (f"k: cannot compile: {user}:7: Untyped global name 'object': "
                                                "Cannot determine Numba type")
+
+
+def _faulty_plant(tmp_path, after: float) -> Path:
+    """The example with an out-of-bounds write in rhs once t > after."""
+    text = EXAMPLE.read_text()
+    body = "    dx[6] = (cmd[2] - c * (m22 - m11) * u * v - pp[PARAMS.d55] * r) / pp[PARAMS.m55]\n"
+    assert text.count(body) == 1
+    path = tmp_path / "oob_plant.py"
+    path.write_text(text.replace(body, body + f"    if t > {after!r}:\n        dx[100000] = 1.0\n"))
+    return path
+
+
+def test_check_and_run_refuse_a_plant_writing_out_of_bounds_naming_its_line(tmp_path, capsys):
+    """The probe runs a plug-in plant's compiled functions bounds-checked: the index error of rhs at
+    t > 0.5 s is named with its file, line and time in one line, by check and run alike (nothing
+    written), and simulate raises PlantFault; the same plant faulting after the probe's horizon passes."""
+    from auvtrack.simulation.probe import PROBE_S, PlantFault
+
+    path = _faulty_plant(tmp_path, 0.5)
+    line = path.read_text().splitlines().index("        dx[100000] = 1.0") + 1
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('[plant]\nmodel = "plugin"\nmodule = "oob_plant.py"\n[controller]\nkind = "pid"\n'
+                        '[sim]\nduration = 3.0\ndt = 0.01\n')
+    lines = []
+    for args in (["check", str(scenario)], ["run", str(scenario), "--out", str(tmp_path / "run")]):
+        assert main(args) == EXIT_BAD_INPUT
+        err = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("compiling kernels")]
+        assert len(err) == 1 and "Traceback" not in err[0], err
+        lines.append(err[0])
+    assert lines[0] == lines[1] and not (tmp_path / "run").exists()
+    assert f"plant.module: {path}:{line}: rhs raised IndexError: index 100000 is out of bounds" in lines[0], lines[0]
+    assert "in the step from t = 0.5" in lines[0] and "bounds-checked probe run of the first 2 s" in lines[0]
+    with pytest.raises(PlantFault, match=rf"oob_plant.py:{line}: rhs raised IndexError"):
+        auvtrack.simulate(str(scenario))
+    (tmp_path / "late").mkdir()
+    _faulty_plant(tmp_path / "late", PROBE_S + 0.5)
+    scenario.write_text(scenario.read_text().replace("oob_plant.py", "late/oob_plant.py"))
+    assert main(["check", str(scenario)]) == 0  # the documented limit: after the probe's horizon it is not seen

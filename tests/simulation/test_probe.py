@@ -167,3 +167,34 @@ def test_a_first_call_that_spends_the_wall_time_loading_the_kernel_is_run_again(
     with pytest.raises(LawFault, match=rf"law.py:{OOB_LINE}: control raised IndexError"):
         probe_module.probe(prep)
     assert len(calls) == 2
+
+
+def test_a_call_stopped_before_its_first_step_is_made_again_even_with_the_kernel_loaded(tmp_path, monkeypatch):
+    """A kernel already loaded can still spend the wall time before its first step (a new
+    specialisation compiling, a starved thread): the probe judges by the steps taken, not by
+    whether the kernel was loaded, and calls it again instead of returning without a verdict
+    (after which an endless law would hang the real run)."""
+    import time
+
+    from auvtrack.engine import kernels
+    from auvtrack.scenario import load_scenario
+    from auvtrack.simulation import pipeline, probe as probe_module
+
+    prep = pipeline.prepare(load_scenario(str(_scenario(tmp_path, OUT_OF_BOUNDS))))
+    key = KernelKey(prep.key.law, prep.key.plant, prep.key.label, checked=True)
+    kernels.warmup([key])
+    assert kernels.kernel(key).signatures  # loaded: the case the loaded-kernel check let through
+    monkeypatch.setattr(probe_module, "PROBE_WALL_S", 0.5)
+    real_call, calls = pipeline.call_kernel, []
+
+    def first_call_stalls(p, out):
+        calls.append(p.key)
+        if len(calls) == 1:
+            time.sleep(1.0)
+            return 0, 0, 0.0  # stopped at its first step: no step taken
+        return real_call(p, out)
+
+    monkeypatch.setattr(pipeline, "call_kernel", first_call_stalls)
+    with pytest.raises(LawFault, match=rf"law.py:{OOB_LINE}: control raised IndexError"):
+        probe_module.probe(prep)
+    assert len(calls) == 2
