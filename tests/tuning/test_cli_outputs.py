@@ -35,9 +35,12 @@ def test_the_preset_is_usable_as_controller_preset(tuned, monkeypatch):
     monkeypatch.setattr(gain_presets, "_gains_root", lambda: out)
     preset = gain_presets.get_gain_preset("pid_remus100_tiny")
     results = json.loads((out / "results.json").read_text())
-    assert preset.kind == "pid" and preset.gains == results["result"]["best_params"]
+    table = results["result"]["table"]  # the searched gains and every other field of the tuned controller
+    assert preset.kind == "pid" and preset.gains == {k: v for k, v in table.items() if k != "kind"}
+    assert {k: preset.gains[k] for k in results["result"]["best_params"]} == results["result"]["best_params"]
+    assert preset.gains["saturation"] == "compensated"  # the designed form of the REMUS, not the law's default
     for key in ("suite", "split", "budget_runs", "sampler", "sampler_seed", "optuna", "auvtrack", "source_hash",
-                "train_score", "validation_score", "cpu_s", "wall_s", "rk4_steps"):
+                "train_score", "validation_score", "cpu_s", "wall_s", "study_runs", "study_rk4_steps", "suite_version"):
         assert key in preset.provenance, key
     assert preset.provenance["budget_runs"] == 3 * preset.provenance["runs_per_trial"]
     sc = load_scenario(paper_scenario_path(), ['controller={kind="pid", preset="pid_remus100_tiny"}'])

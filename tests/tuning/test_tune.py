@@ -145,3 +145,15 @@ def test_a_running_trial_of_a_live_process_is_not_taken_back(tmp_path):
     assert states[live.number] == "RUNNING" and states[dead.number] == "FAIL"
     waiting = [t for t in s.get_trials() if t.state.name == "WAITING"]
     assert len(waiting) == 1 and s.ask({"x": optuna.distributions.FloatDistribution(0, 1)}).params == dead.params  # asked again with the same gains
+
+
+def test_a_resumed_tuning_reports_the_whole_studys_cost(suite_path, tmp_path):
+    import tomllib
+
+    first = tune("pid", suite_path, trials=2, out=tmp_path / "c", validate=False)
+    again = tune("pid", suite_path, trials=2, out=tmp_path / "c", validate=False)  # nothing left to fly
+    assert again.runs == 0 and first.runs > 0 and again.study_cost["runs"] == first.study_cost["runs"] == first.runs
+    prov = tomllib.loads(again.outputs["preset"].read_text())["provenance"]
+    assert prov["study_runs"] == first.runs and prov["study_rk4_steps"] == first.steps
+    assert prov["wall_s"] >= round(first.wall_s, 3) and prov["cpu_s"] > 0
+    assert (prov["suite"], prov["suite_version"]) == ("tiny", 1)  # name and version, not one "tiny v1" label
