@@ -104,11 +104,13 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
     Returns
     -------
     dict of str to Path
-        ``preset`` (absent when no trial completed), ``results``, ``report``.
+        ``preset`` (absent when no trial completed), ``results``, ``report``, ``slices`` (the
+        slice figure, absent when no trial finished).
     """
     import optuna
 
     from .. import __version__
+    from .slices import slice_figure
     from ..jit import source_hash
     from ..report import Report, write_json
 
@@ -155,6 +157,12 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
         rep.table(["task", "tier", "seed index", "status", "cause", "t_stop (s)", "score"],
                   [[r["task"], r["tier"], r["seed_index"], r["status"], r["cause"], r["t_stop"], r["score"]]
                    for r in res.validation_runs])
+    fig = slice_figure(study)
+    if fig is not None:
+        rep.heading("Slices")
+        paths["slices"] = rep.figure(fig, "slices", "Objective of every finished trial against each searched gain "
+                                     "(complete: its score; refused by a set-up condition: the refusal score; "
+                                     "pruned: the mean score of the runs flown before the failure).")
     rep.heading("Optimisation history")
     best, rows = math.inf, []
     for t in trials:

@@ -62,3 +62,25 @@ def test_bad_input_is_one_line(tuned, tmp_path, args, field):
     r = CliRunner().invoke(cli, ["tune", "--suite", str(root / "tiny.toml"), "--out", str(tmp_path / "x"), *args])
     assert r.exit_code == 2 and field in r.output and "Traceback" not in r.output
     assert not (tmp_path / "x").exists()  # refused before anything is stored
+
+
+def test_the_slices_are_the_studys_trials(tuned):
+    import optuna
+
+    from auvtrack.tuning.slices import slice_points
+
+    root, _ = tuned
+    out = root / "out"
+    study = optuna.load_study(study_name="tune", storage=f"sqlite:///{out / 'study.db'}")
+    points = slice_points(study)
+    trials = json.loads((out / "results.json").read_text())["trials"]
+    assert list(points) == ["kp", "ki", "kd", "kaw"]
+    for name, pts in points.items():  # every finished trial once per gain, at its value and score
+        finished = [t for t in trials if t["state"] in ("COMPLETE", "PRUNED")]
+        assert [(p.trial, p.value) for p in pts] == [(t["number"], t["params"][name]) for t in finished]
+        for p, t in zip(pts, finished):
+            if t["state"] == "COMPLETE":
+                assert p.score == t["value"] and p.state == ("refused" if t["user_attrs"]["violations"] else "complete")
+            else:
+                assert p.state == "pruned"
+    assert (out / "figures" / "slices.png").is_file() and "figures/slices.png" in (out / "report.md").read_text()
