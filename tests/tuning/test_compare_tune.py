@@ -97,3 +97,20 @@ def test_every_shipped_suite_with_tuned_presets_has_one_shared_budget(name):
         preset = gain_presets.get_gain_preset(f"{k}_remus100_{name}")
         assert preset.kind == k and preset.provenance["split"] == "training"
         assert preset.provenance["budget_runs"] == trials * preset.provenance["runs_per_trial"]
+
+
+def test_the_v2_suite_flies_its_own_presets_and_names_a_missing_one(tmp_path, monkeypatch):
+    from auvtrack.benchmark.suite import resolve_controllers, tracking_kinds
+
+    suite = load_suite("auv-track-v2", check=False)
+    assert suite.file.gain_preset == "{kind}_remus100_auv-track-v2"
+    for e in resolve_controllers(None, gain_preset=suite.file.gain_preset):
+        name = f"{e.label}_remus100_auv-track-v2"
+        if name in gain_presets.available_gain_presets():
+            assert e.table == {"kind": e.label, "preset": name}
+            assert gain_presets.get_gain_preset(name).provenance["suite"] == suite.name
+        else:  # flown untuned, and the entry says which preset is missing
+            assert e.table == {"kind": e.label} and f"no gain preset {name!r} is installed" in e.gains
+    monkeypatch.setattr(gain_presets, "_gains_root", lambda: tmp_path)  # none installed: every entry says so
+    assert all("is installed" in e.gains for e in resolve_controllers(None, gain_preset=suite.file.gain_preset))
+    assert len(tracking_kinds()) == len(resolve_controllers(None, gain_preset=suite.file.gain_preset))
