@@ -3,7 +3,7 @@
     python tools/preset_acceptance.py [--suite auv-track-v2] [--quick] [--json FILE]
 
 Prints one line per controller (runs completed / flown, infeasible tasks not flown, a missing
-preset) and one per failed run (truth, reference, cause, time): :mod:`auvtrack.tuning.acceptance`.
+preset) and one per failed run (truth, reference, cause, time): :mod:`auvtrack.studies.preset_acceptance`.
 """
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from dataclasses import asdict
 
 def main(argv: list[str] | None = None) -> int:
     """Fly the check and print it; return 0 when every flown run completed, 1 otherwise."""
-    from auvtrack.tuning.acceptance import acceptance
+    from auvtrack.studies.preset_acceptance import acceptance
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--suite", default="auv-track-v2")

@@ -63,7 +63,7 @@ def acceptance_runs(suite: str = "auv-track-v2", quick: bool = False) -> list[tu
         One per controller (every tracking built-in), truth and reference.
     """
     from ..benchmark.suite import tracking_kinds
-    from ..studies import model_gap
+    from . import model_gap
 
     refs = ("helix",) if quick else tuple(model_gap.REFERENCES)
     return [(k, f"{k}_remus100_{suite}", t, r) for k in tracking_kinds() for t in TRUTHS for r in refs]
@@ -90,7 +90,7 @@ def acceptance(suite: str = "auv-track-v2", *, quick: bool = False, duration: fl
     from ..report import failure_cause
     from ..scenario import load_scenario
     from ..simulation.pipeline import prepare, run_prepared
-    from ..studies import model_gap
+    from . import model_gap
 
     duration = duration if duration is not None else (20.0 if quick else 150.0)
     shipped = set(available_gain_presets())

@@ -6,7 +6,7 @@ import pytest
 from auvtrack.benchmark.suite import tracking_kinds
 from auvtrack.control import gain_presets
 from auvtrack.studies import model_gap
-from auvtrack.tuning.acceptance import acceptance, acceptance_runs
+from auvtrack.studies.preset_acceptance import acceptance, acceptance_runs
 
 
 def test_the_check_flies_every_controller_on_both_truths_and_every_reference_calm():
