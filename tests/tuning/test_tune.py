@@ -45,7 +45,7 @@ def test_trial_value_is_the_benchmark_score_of_its_runs(suite_path, tmp_path):
 
 
 def test_the_first_candidate_holds_the_untuned_gains(suite_path, tmp_path):
-    # the tiny suite sets no actuator limit, so the saturation form a bare table gets does not matter here
+    # trial 0 is the bare table's controller: its gains and, through designed_base, every other field
     res = tune("pid", suite_path, trials=1, out=tmp_path / "d0", validate=False)
     (state, params, value), = _trials(tmp_path / "d0")
     st = load_suite(suite_path)
