@@ -1,6 +1,6 @@
 """Tune every built-in tracking controller with the same budget and ship the presets.
 
-    python tools/tune_presets.py --suite auv-track-v1 --budget 200 --out tune-presets [--install]
+    python tools/tune_presets.py --suite auv-track-v2 --budget 200 --parallel 2 --out tune-presets [--install]
 
 Each controller is tuned by :func:`auvtrack.tuning.tune` on the suite's training split with the
 same sampler, seed and number of trials (the budget is trials x training runs, the same for all),
@@ -22,7 +22,7 @@ def main(argv: list[str] | None = None) -> int:
     from auvtrack.tuning import tune
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--suite", default="auv-track-v1")
+    ap.add_argument("--suite", default="auv-track-v2")
     ap.add_argument("--budget", type=int, required=True, help="trials per controller")
     ap.add_argument("--out", default="tune-presets")
     ap.add_argument("--sampler", default="tpe")

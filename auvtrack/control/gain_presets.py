@@ -2,7 +2,10 @@
 
 A preset is ``auvtrack/data/gains/<name>.toml``: the controller ``kind``, a ``[gains]`` table of
 its ``[controller]`` keys, a description and how the gains were produced.  ``controller.preset``
-in a scenario expands a preset into those keys.
+in a scenario expands a preset into those keys.  A key holds a number (read as a float), a
+string or boolean (e.g. ``saturation = "compensated"``), a list of numbers (a vector field) or,
+for a plug-in, a table (its ``params``): a preset states every field of the controller it
+reproduces, not only the numeric gains.
 """
 from __future__ import annotations
 
@@ -26,8 +29,8 @@ class GainPreset:
         Controller kind the gains belong to (``"ftsmc"`` or ``"fxtntsmc"``).
     description : str
         One line: where the gains come from.
-    gains : dict of str to float
-        Scenario keys of ``[controller]`` and their values.
+    gains : dict
+        Scenario keys of ``[controller]`` and their values (numbers as floats).
     provenance : dict
         How the gains were produced (study, optimiser, seed, budget, objective values).
     """
@@ -75,7 +78,8 @@ def get_gain_preset(name: str) -> GainPreset:
     KeyError
         Unknown name (the message lists the available presets).
     ValueError
-        A malformed preset file (missing ``kind`` or ``[gains]``, or a gain that is not a number).
+        A malformed preset file (missing ``kind`` or ``[gains]``, or a value that is not a
+        number, string, boolean, list of numbers or table of those).
     """
     names = available_gain_presets()
     if name not in names:
@@ -84,9 +88,21 @@ def get_gain_preset(name: str) -> GainPreset:
     kind, gains = raw.get("kind"), raw.get("gains")
     if not isinstance(kind, str) or not isinstance(gains, dict):
         raise ValueError(f"gain preset {name!r}: needs a string 'kind' and a [gains] table")
-    for k, v in gains.items():
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise ValueError(f"gain preset {name!r}: gains.{k} must be a number (got {v!r})")
+    gains = {k: _preset_value(f"gain preset {name!r}: gains.{k}", v) for k, v in gains.items()}
     return GainPreset(name=name, kind=kind, description=str(raw.get("description", "")),
-                      gains={k: float(v) for k, v in gains.items()},
+                      gains=gains,
                       provenance=dict(raw.get("provenance", {})))
+
+
+def _preset_value(where: str, v, nested: bool = True):
+    """A ``[gains]`` value as the scenario reads it: numbers as floats, strings, booleans, lists, tables."""
+    if isinstance(v, bool) or isinstance(v, str):
+        return v
+    if isinstance(v, (int, float)):
+        return float(v)
+    if isinstance(v, list) and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+        return [float(x) for x in v]
+    if isinstance(v, dict) and nested:
+        return {k: _preset_value(f"{where}.{k}", x, nested=False) for k, x in v.items()}
+    raise ValueError(f"{where} must be a number, string, boolean, list of numbers or (plug-in params) a table "
+                     f"of those (got {v!r})")

@@ -85,7 +85,8 @@ class Params(ControllerParams):
     kd: float = tunable(8.0, 0.05, 50.0, log=True, gt=0, description="gain on eps_dot, 1/s")
     l: float = tunable(0.3, 0.01, 2.0, log=True, gt=0, description="envelope decay rate, 1/s")
     rho0: tuple[Pos, Pos, Pos] = Field((5.0, 1.5, 1.0), description="rho(0) per axis, m")
-    rho_inf: tuple[Pos, Pos, Pos] = Field((0.005, 0.005, 0.005), description="rho(inf) per axis, m")
+    rho_inf: tuple[Pos, Pos, Pos] = tunable((0.005, 0.005, 0.005), 0.005, 1.0, log=True,
+                                            description="rho(inf) per axis, m (searched as one value for the three axes)")
     k_aux: float = tunable(1.0, 0.01, 10.0, log=True, gt=0, description="rate of the auxiliary system (R5), 1/s (saturation = 'compensated')")
     saturation: Literal[SATURATION] = Field(
         "published", description="'published': eq. (R4); 'compensated': the envelope on the error less the "

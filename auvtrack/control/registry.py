@@ -37,17 +37,21 @@ class ControllerParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-def tunable(default: float, low: float, high: float, *, log: bool = False, **field_kwargs: Any) -> Any:
+def tunable(default: float | tuple[float, ...], low: float, high: float, *, log: bool = False,
+            per_item: bool = False, **field_kwargs: Any) -> Any:
     """A gain field of a ``Params`` model with its search space for ``auvtrack tune``.
 
     Parameters
     ----------
-    default : float
-        The field's default.
+    default : float or tuple of float
+        The field's default (a tuple: a vector field, each item searched in [low, high]).
     low, high : float
         The range searched (inclusive), inside the field's own admissible range.
     log : bool, optional
         Search on a logarithmic scale (``low > 0``).
+    per_item : bool, optional
+        For a vector field: one searched value per item; by default one value shared by every
+        item (:mod:`auvtrack.tuning.space`).
     **field_kwargs
         Passed to :func:`pydantic.Field` (``gt``, ``ge``, ``description``...).
 
@@ -66,7 +70,7 @@ def tunable(default: float, low: float, high: float, *, log: bool = False, **fie
     if log and low <= 0:
         raise ValueError(f"tunable: a log scale needs low > 0 (got {low})")
     extra = dict(field_kwargs.pop("json_schema_extra", None) or {})
-    extra["tune"] = {"low": float(low), "high": float(high), "log": bool(log)}
+    extra["tune"] = {"low": float(low), "high": float(high), "log": bool(log), **({"per_item": True} if per_item else {})}
     return Field(default, json_schema_extra=extra, **field_kwargs)
 
 

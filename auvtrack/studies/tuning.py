@@ -1,9 +1,10 @@
 """``auvtrack study tuning``: fair tuning of every built-in closed-loop controller.
 
 Every controller (the paper's FXTNTSMC and the baselines FTSMC, PID, backstepping, STA and PPC)
-gets the **same** optimiser (SciPy ``differential_evolution``, fixed seed, fixed population and
-generation count, no gradient polish), the **same** budget (24 candidates per generation, the
-same number of closed-loop evaluations whether it tunes three gains or four), the **same**
+gets the **same** optimiser (Optuna's TPE, the optimiser of ``auvtrack tune``, fixed seed, the
+package defaults as the first trial, batches of 24 candidates asked together and flown in
+threads), the **same** budget (the same number of closed-loop evaluations whether it tunes three
+gains or four), the **same**
 objective and the **same** training scenarios (Section 4 and two variations).  The tuned gains are then evaluated on
 held-out scenarios that the optimiser never saw, and written as gain presets
 (``auvtrack/data/gains/<kind>_tuned.toml`` shape) usable from any scenario as
@@ -17,7 +18,8 @@ with ITAE in m s^2, energy in N^2 s (N^2 m^2 s for moments) and TV the total var
 per second on a 10 ms grid.  A run that fails (pitch limit, divergence, envelope violation)
 costs ``penalty * (2 - t_fail / duration)``, more than any finite run and decreasing the
 longer the run survived; a candidate that the controller's own conditions refuse (Theorem 1
-for the FXTNTSMC, the ``setup`` gain checks of the others) costs ``3 * penalty``.  The objective
+for the FXTNTSMC, the ``setup`` gain checks of the others: the constraints of ``auvtrack tune``,
+:func:`auvtrack.tuning.space.constraint_violations`) costs ``3 * penalty``.  The objective
 of a gain vector is the mean of J over the scenarios.
 """
 from __future__ import annotations
@@ -31,8 +33,6 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
-from scipy.optimize import differential_evolution
-
 from ..control import get as get_controller
 from ..scenario import load_scenario
 from ..simulation.compiling import compile_first
@@ -113,8 +113,7 @@ class GainSpace:
 # One-to-one counterparts: switching gain k1 <-> kappa1, linear reaching gain k2 <-> kappa3,
 # surface weight beta <-> a1, surface exponent gamma <-> alpha.  The FXTNTSMC box keeps every
 # condition of Theorem 1 (kappa3 > 0.5; 0.5 < alpha, a2 alpha < 1 and a4 alpha > 1 with the
-# paper's a2 = 0.8, a4 = 2); the objective re-checks them with the controller's ``warnings`` (for
-# the FXTNTSMC, auvtrack.control.fxtntsmc.theory.check_theorem1).
+# paper's a2 = 0.8, a4 = 2); the objective re-checks them (auvtrack.tuning.space.constraint_violations).
 # The baselines tune their three loop gains (docs/controllers.md) in boxes spanning two decades or
 # more around the defaults (the integral and adaptation gains down to 1e-4, near switched off); the PID's ki >= kd kp and the STA's Moreno-Osorio condition
 # (with the default L) cut parts of their boxes, which setup refuses and the objective penalises.
@@ -223,9 +222,9 @@ class Budget:
     Attributes
     ----------
     popsize : int
-        Population multiplier of ``differential_evolution`` for four gains: every controller
-        evaluates :attr:`population` = popsize x 4 candidates per generation (a three-gain
-        space uses the multiplier population / 3, see :meth:`de_popsize`).
+        Batch multiplier for four gains: every controller asks :attr:`population` = popsize x 4
+        candidates per batch (a three-gain space ceil(population / 3) x 3, see :meth:`de_popsize`;
+        the budget of the study's earlier differential evolution, kept so its results compare).
     maxiter : int
         Generations after the initial population.
     seed : int
@@ -246,16 +245,16 @@ class Budget:
 
     @property
     def population(self) -> int:
-        """Candidates per generation, the same for every controller: popsize x 4."""
+        """Candidates per batch, the same for every controller: popsize x 4."""
         return self.popsize * 4
 
     @property
     def max_evaluations(self) -> int:
-        """Gain vectors evaluated (``polish=False``): popsize x 4 x (maxiter + 1)."""
+        """Gain vectors evaluated for four gains: popsize x 4 x (maxiter + 1)."""
         return self.population * (self.maxiter + 1)
 
     def de_popsize(self, n_gains: int) -> int:
-        """``differential_evolution``'s multiplier for ``n_gains`` gains: ceil(population / n_gains)."""
+        """The batch multiplier for ``n_gains`` gains: ceil(population / n_gains)."""
         return -(-self.population // n_gains)
 
     def evaluations(self, n_gains: int) -> int:
@@ -372,7 +371,7 @@ def _threads(workers: int | None) -> int:
 def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *,
          cases: Sequence[Case] | None = None, workers: int | None = None,
          progress: Callable[[str], None] | None = None) -> TuneResult:
-    """Tune the gains of ``kind`` with seeded differential evolution.
+    """Tune the gains of ``kind`` with Optuna's seeded TPE (the package defaults first).
 
     Parameters
     ----------
@@ -385,10 +384,10 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     cases : sequence of Case, optional
         Training scenarios (default: the first ``budget.n_train`` of :data:`TRAIN_CASES`).
     workers : int, optional
-        Threads evaluating a generation (the compiled kernel releases the GIL; default
+        Threads evaluating a batch (the compiled kernel releases the GIL; default
         :func:`auvtrack.batch.runner.default_workers`); the result does not depend on it.
     progress : callable, optional
-        Called with a one-line status after each generation.
+        Called with a one-line status after each batch.
 
     Returns
     -------
@@ -398,41 +397,40 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     """
     if kind not in SPACES:
         raise ValueError(f"kind: must be one of {sorted(SPACES)} (got {kind!r})")
+    import optuna
+
+    from ..tuning.space import Dimension, constraint_violations, distributions
+
     space = SPACES[kind]
     cases = tuple(TRAIN_CASES[: budget.n_train] if cases is None else cases)
 
-    spec = get_controller(kind)
-
     def mean_cost(gains: dict[str, float]) -> float:
-        if spec.warnings is not None and spec.warnings(spec.params(**gains)):
-            return 3.0 * objective.penalty  # outside its stability conditions (the box already excludes them)
-        try:
-            return float(np.mean([run_cost(c, kind, gains, budget.duration, budget.dt, objective)[0]
-                                  for c in cases]))
-        except ValueError:  # the controller's setup refuses the gains (its gain conditions)
-            return 3.0 * objective.penalty
-
-    def f(u: np.ndarray) -> float:
-        return mean_cost(space.to_gains(u))
+        if constraint_violations(load_scenario(case_scenario(cases[0], kind, gains, budget.duration, budget.dt))):
+            return 3.0 * objective.penalty  # refused at set-up: Theorem 1, the gain checks
+        return float(np.mean([run_cost(c, kind, gains, budget.duration, budget.dt, objective)[0] for c in cases]))
 
     start = space.defaults()
+    dists = distributions({n: Dimension(n, lo, hi, lg, start[n])
+                           for n, (lo, hi), lg in zip(space.names, space.bounds, space.log)})
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    study = optuna.create_study(direction="minimize", sampler=optuna.samplers.TPESampler(seed=budget.seed))
+    study.enqueue_trial(start)
+    total, batch = budget.evaluations(len(space.names)), budget.population
     history: list[float] = []
     wall = time.perf_counter()
     with ThreadPoolExecutor(max_workers=_threads(workers)) as pool:
-        def callback(intermediate_result):  # SciPy >= 1.12: an OptimizeResult with x and fun
-            history.append(float(intermediate_result.fun))
+        while len(study.trials) < total:  # a batch is asked before any is told: threads do not change it
+            trials = [study.ask(dists) for _ in range(min(batch, total - len(study.trials)))]
+            for t, value in zip(trials, pool.map(lambda t: mean_cost(dict(t.params)), trials)):
+                study.tell(t, value)
+            history.append(float(study.best_value))
             if progress:
-                progress(f"{kind}: generation {len(history)}/{budget.maxiter}, best J = {history[-1]:.4g}")
-
-        res = differential_evolution(
-            f, space.search_bounds(), seed=budget.seed, popsize=budget.de_popsize(len(space.names)),
-            maxiter=budget.maxiter,
-            tol=0.0, atol=0.0, polish=False, init="latinhypercube", x0=space.to_search(start),
-            updating="deferred", workers=pool.map, callback=callback)
+                progress(f"{kind}: batch {len(history)}/{budget.maxiter + 1}, best J = {history[-1]:.4g}")
     wall = time.perf_counter() - wall
-    gains = _rounded(space.to_gains(res.x))
+    best = min(study.trials, key=lambda t: (t.value, t.number))
+    gains = _rounded({n: float(best.params[n]) for n in space.names})
     return TuneResult(kind=kind, gains=gains, train_objective=mean_cost(gains), start_gains=start,
-                      start_objective=mean_cost(start), nfev=int(res.nfev), nit=int(res.nit),
+                      start_objective=mean_cost(start), nfev=len(study.trials), nit=len(history),
                       wall_s=wall, history=history)
 
 
@@ -494,7 +492,7 @@ def preset_toml(result: TuneResult, budget: Budget, objective: Objective) -> str
         "# (keys given explicitly next to `preset` override these gains).",
         "",
         f"kind = \"{result.kind}\"",
-        f"description = \"{result.kind} gains tuned by differential evolution on Section 4 + 2 variations "
+        f"description = \"{result.kind} gains tuned by Optuna TPE on Section 4 + 2 variations "
         f"(seed {budget.seed}, {result.nfev} evaluations)\"",
         "",
         "[gains]",
@@ -502,7 +500,8 @@ def preset_toml(result: TuneResult, budget: Budget, objective: Objective) -> str
         "",
         "[provenance]",
         "study = \"auvtrack study tuning\"",
-        "optimiser = \"scipy.optimize.differential_evolution (polish = false, init = latinhypercube, x0 = package defaults)\"",
+        f"optimiser = \"optuna {_optuna_version()} TPESampler (seeded; trial 0 = package defaults; batches of "
+        f"{budget.de_popsize(len(space.names)) * len(space.names)} asked together)\"",
         f"seed = {budget.seed}",
         f"popsize = {budget.de_popsize(len(space.names))}",
         f"population = {budget.de_popsize(len(space.names)) * len(space.names)}",
@@ -522,6 +521,12 @@ def preset_toml(result: TuneResult, budget: Budget, objective: Objective) -> str
     return "\n".join(lines)
 
 
+def _optuna_version() -> str:
+    import optuna
+
+    return optuna.__version__
+
+
 def _fmt(x: float) -> str:
     return "inf" if not math.isfinite(x) else f"{x:.4g}"
 
@@ -531,8 +536,8 @@ def _report(out: Path, results: dict[str, TuneResult], evals: dict, budget: Budg
     rep = Report(out, "Fair tuning of the controllers")
     if quick:
         rep.paragraph("**Quick mode** (CI smoke test): tiny budget, short runs; the numbers are not meaningful.")
-    rep.paragraph(f"Optimiser: SciPy differential_evolution, seed {budget.seed}, {budget.population} candidates "
-                  f"per generation, maxiter {budget.maxiter}, polish off, the package defaults as first candidate. "
+    rep.paragraph(f"Optimiser: Optuna TPE, seed {budget.seed}, batches of {budget.population} candidates, "
+                  f"{budget.maxiter + 1} batches, the package defaults as first candidate. "
                   f"Training: {', '.join(c.name for c in TRAIN_CASES[: budget.n_train])} "
                   f"({budget.duration:g} s, dt {budget.dt:g} s). Held-out: "
                   f"{', '.join(c.name for c in heldout)} ({budget.heldout_duration:g} s).")
@@ -574,7 +579,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     quick : bool, optional
         CI smoke test: about 16 evaluations of one 4 s scenario per controller.
     progress : bool, optional
-        Print one line per generation.
+        Print one line per batch.
 
     Returns
     -------

@@ -27,7 +27,8 @@ def shared_budget(suite) -> int:
     Returns
     -------
     int
-        The trials of every preset whose provenance names this suite.
+        The trials of every preset whose provenance names this suite and its version
+        (``suite`` and ``suite_version``).
 
     Raises
     ------
@@ -39,7 +40,8 @@ def shared_budget(suite) -> int:
     budgets = {}
     for name in available_gain_presets():
         prov = get_gain_preset(name).provenance or {}
-        if prov.get("tool") == "auvtrack tune" and str(prov.get("suite", "")).split(" v")[0] == suite.name:
+        if (prov.get("tool") == "auvtrack tune" and prov.get("suite") == suite.name
+                and prov.get("suite_version") == suite.file.version):
             budgets[name] = int(prov["budget_trials"])
     if not budgets:
         raise ValueError(f"--tune: no preset tuned on {suite.name} is installed to take the shared budget from; "
@@ -95,7 +97,8 @@ def tune_newcomers(suite, entries: Sequence, trials: int, out: str | Path, *, se
     list of ControllerEntry
         The entries, each plug-in's table holding its tuned ``params``.
     """
-    from .study import tune
+    from .space import field_values, search_space
+    from .study import _params_model, tune
 
     source = suite.source
     result = []
@@ -108,7 +111,8 @@ def tune_newcomers(suite, entries: Sequence, trials: int, out: str | Path, *, se
         if not res.best_params:
             raise ValueError(f"--tune: {e.label}: no trial of {trials} completed the training split "
                              f"({res.pruned} pruned, {res.refused} refused); see {tune_folder(out) / e.label}")
-        table = {**e.table, "params": {**dict(e.table.get("params") or {}), **res.best_params}}
+        tuned = field_values(search_space(_params_model(e.table)), res.best_params)
+        table = {**e.table, "params": {**dict(e.table.get("params") or {}), **tuned}}
         gains = (f"plug-in {Path(e.table['module']).name}: tuned by auvtrack tune on {res.suite} training split, "
                  f"{res.trials} trials (train {res.best_score:.4g}, validation {res.validation_score:.4g})")
         result.append(dataclasses.replace(e, table=table, gains=gains))

@@ -25,19 +25,20 @@ def candidate_table(base: Mapping[str, Any], gains: Mapping[str, float]) -> dict
     ----------
     base : mapping
         ``kind`` (and ``module`` for a plug-in, other fixed keys).
-    gains : mapping of str to float
-        The candidate's gains.
+    gains : mapping of str to float or list of float
+        The candidate's field values (:func:`auvtrack.tuning.space.field_values`).
 
     Returns
     -------
     dict
         The table.
     """
+    values = {k: [float(x) for x in v] if isinstance(v, (list, tuple)) else float(v) for k, v in gains.items()}
     table = dict(base)
     if table.get("kind") == "plugin":
-        table["params"] = {**dict(table.get("params") or {}), **{k: float(v) for k, v in gains.items()}}
+        table["params"] = {**dict(table.get("params") or {}), **values}
     else:
-        table.update({k: float(v) for k, v in gains.items()})
+        table.update(values)
     return table
 
 

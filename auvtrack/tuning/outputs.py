@@ -48,6 +48,9 @@ def _toml_value(v: Any) -> str:
 def preset_text(res, provenance: dict[str, Any]) -> str:
     """The gain preset file (``kind``, ``description``, ``[gains]``, ``[provenance]``) of a tuning.
 
+    ``[gains]`` holds the best candidate's whole table (:attr:`TuneResult.table`): the searched
+    gains and every other field, so the preset reproduces the controller that was tuned.
+
     Parameters
     ----------
     res : TuneResult
@@ -61,9 +64,14 @@ def preset_text(res, provenance: dict[str, Any]) -> str:
         TOML text readable by :func:`auvtrack.control.gain_presets.get_gain_preset`.
     """
     kind = res.controller["kind"]
-    desc = f"{kind} gains tuned by auvtrack tune on {res.suite} ({res.split} split, {res.trials} trials)"
+    desc = (f"{kind} gains tuned by auvtrack tune on {res.suite} version {res.suite_version} ({res.split} split, "
+            f"{res.trials} trials)")
+    table = {k: v for k, v in (res.table or res.best_params).items() if k != "kind"}
+    nested = {k: v for k, v in table.items() if isinstance(v, dict)}
     lines = [f"kind = {_toml_value(kind)}", f"description = {_toml_value(desc)}", "", "[gains]"]
-    lines += [f"{k} = {_toml_value(float(v))}" for k, v in res.best_params.items()]
+    lines += [f"{k} = {_toml_value(v)}" for k, v in table.items() if k not in nested]
+    for k, sub in nested.items():
+        lines += ["", f"[gains.{k}]"] + [f"{n} = {_toml_value(v)}" for n, v in sub.items()]
     lines += ["", "[provenance]"] + [f"{k} = {_toml_value(v)}" for k, v in provenance.items()]
     return "\n".join(lines) + "\n"
 
@@ -96,11 +104,13 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
     Returns
     -------
     dict of str to Path
-        ``preset`` (absent when no trial completed), ``results``, ``report``.
+        ``preset`` (absent when no trial completed), ``results``, ``report``, ``slices`` (the
+        slice figure, absent when no trial finished).
     """
     import optuna
 
     from .. import __version__
+    from .slices import slice_figure
     from ..jit import source_hash
     from ..report import Report, write_json
 
@@ -112,18 +122,20 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
         importances = {k: float(v) for k, v in optuna.importance.get_param_importances(study).items()}
     except (RuntimeError, ValueError, ZeroDivisionError):  # too few complete trials
         importances = {}
-    provenance = {"tool": "auvtrack tune", "suite": res.suite, "split": res.split,
-                  "budget_trials": res.trials, "runs_per_trial": runs_per_trial,
+    cost = res.study_cost
+    provenance = {"tool": "auvtrack tune", "suite": res.suite, "suite_version": res.suite_version,
+                  "split": res.split, "budget_trials": res.trials, "runs_per_trial": runs_per_trial,
                   "budget_runs": res.trials * runs_per_trial, "sampler": sampler, "sampler_seed": seed,
                   "first_candidate": next((t["user_attrs"].get("first_candidate", "sampled") for t in trials
                                            if t["number"] == 0), "sampled"),
                   "optuna": optuna.__version__, "auvtrack": __version__, "source_hash": source_hash()[:16],
                   "train_score": res.best_score, "validation_score": res.validation_score,
                   "complete": res.complete, "pruned": res.pruned, "refused": res.refused,
-                  "runs_flown": res.runs, "rk4_steps": res.steps, "cpu_s": round(res.cpu_s, 3),
-                  "wall_s": round(res.wall_s, 3), "study_runs": res.study_cost.get("runs", 0),
-                  "study_rk4_steps": res.study_cost.get("steps", 0),
-                  **{f"study_{k}": round(res.study_cost[k], 3) for k in ("cpu_s", "wall_s") if k in res.study_cost},
+                  # the whole study's cost (every process and every resumed call), not the last call's
+                  "study_runs": cost.get("runs", 0), "study_rk4_steps": cost.get("steps", 0),
+                  "cpu_s": round(cost.get("cpu_s", math.nan), 3), "wall_s": round(cost.get("elapsed_s", res.wall_s), 3),
+                  "trials_wall_s": round(cost.get("wall_s", math.nan), 3),
+                  "validation_runs": len(res.validation_runs),
                   "tuned": list(res.best_params)}
     paths: dict[str, Path] = {}
     if res.best_params:
@@ -132,7 +144,7 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
         paths["preset"].write_text(preset_text(res, provenance))
     paths["results"] = write_json(out / "results.json", {"result": asdict(res), "provenance": provenance,
                                                         "importances": importances, "trials": trials})
-    rep = Report(out, f"Tuning of {res.controller['kind']} on {res.suite}")
+    rep = Report(out, f"Tuning of {res.controller['kind']} on {res.suite} version {res.suite_version}")
     rep.paragraph(f"{res.trials} trials ({res.complete} complete, {res.pruned} pruned after a failed run, "
                   f"{res.refused} refused by a set-up condition) on the {res.split} split; {res.runs} runs, "
                   f"{res.steps} RK4 steps, {res.cpu_s:.1f} CPU s, {res.wall_s:.1f} wall s in this process.")
@@ -145,6 +157,12 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
         rep.table(["task", "tier", "seed index", "status", "cause", "t_stop (s)", "score"],
                   [[r["task"], r["tier"], r["seed_index"], r["status"], r["cause"], r["t_stop"], r["score"]]
                    for r in res.validation_runs])
+    fig = slice_figure(study)
+    if fig is not None:
+        rep.heading("Slices")
+        paths["slices"] = rep.figure(fig, "slices", "Objective of every finished trial against each searched gain "
+                                     "(complete: its score; refused by a set-up condition: the refusal score; "
+                                     "pruned: the mean score of the runs flown before the failure).")
     rep.heading("Optimisation history")
     best, rows = math.inf, []
     for t in trials:

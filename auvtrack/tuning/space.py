@@ -1,7 +1,10 @@
 """The search space of a controller: the gains its ``Params`` model declares tunable, and its constraints.
 
 A gain is tunable when its field was made by :func:`auvtrack.control.registry.tunable`: the range
-searched and the scale are stored in the field's ``json_schema_extra["tune"]``.  Built-ins and
+searched and the scale are stored in the field's ``json_schema_extra["tune"]``.  A vector field
+(a tuple default, e.g. the PPC's ``rho_inf``) is searched as one scalar shared by its items, or
+with ``per_item`` as one scalar per item (dimensions ``name[0]``, ``name[1]``...);
+:func:`field_values` turns a candidate's searched values back into field values.  Built-ins and
 plug-ins declare it the same way, in the controller's own module; :func:`search_space` is the
 only reader.  The conditions a controller checks at set-up (Theorem 1 for the FXTNTSMC through
 its ``warnings``, the STA's Levant / Moreno-Osorio inequalities, the PID's Routh-Hurwitz bound,
@@ -16,23 +19,29 @@ from typing import Any, Mapping
 
 from pydantic import BaseModel
 
-__all__ = ["Dimension", "search_space", "distributions", "constraint_violations"]
+__all__ = ["Dimension", "search_space", "distributions", "field_values", "searched_fields", "constraint_violations"]
 
 
 @dataclass(frozen=True)
 class Dimension:
-    """One tunable gain.
+    """One searched scalar: a tunable gain, or the items of a vector gain (shared or one of them).
 
     Attributes
     ----------
     name : str
-        The ``Params`` field.
+        The dimension's name: the ``Params`` field, or ``field[i]`` for one item of a vector.
     low, high : float
         The range searched (inclusive).
     log : bool
         Searched on a logarithmic scale.
     default : float
-        The field's default.
+        The field's default (a vector's: the mean of its items when shared, the item's otherwise).
+    field : str
+        The ``Params`` field set (``name`` when empty).
+    size : int
+        Items of a vector field (0: a scalar field).
+    item : int or None
+        The item this dimension sets (None: a scalar, or every item of a shared vector).
     """
 
     name: str
@@ -40,6 +49,14 @@ class Dimension:
     high: float
     log: bool
     default: float
+    field: str = ""
+    size: int = 0
+    item: int | None = None
+
+    @property
+    def target(self) -> str:
+        """The ``Params`` field this dimension sets."""
+        return self.field or self.name
 
     def contains(self, value: float) -> bool:
         """Whether ``value`` lies in [low, high]."""
@@ -74,8 +91,64 @@ def search_space(params: type[BaseModel]) -> dict[str, Dimension]:
         if not (math.isfinite(low) and math.isfinite(high) and low < high) or (log and low <= 0):
             raise ValueError(f"{params.__module__}.Params.{name}: tunable range [{low}, {high}] "
                              f"(log={log}) is not a valid search range")
-        space[name] = Dimension(name, low, high, log, float(info.default))
+        default = info.default
+        if not isinstance(default, (tuple, list)):
+            space[name] = Dimension(name, low, high, log, float(default))
+        elif tune.get("per_item"):
+            for i, v in enumerate(default):
+                space[f"{name}[{i}]"] = Dimension(f"{name}[{i}]", low, high, log, float(v), name, len(default), i)
+        else:
+            space[name] = Dimension(name, low, high, log, math.fsum(default) / len(default), name, len(default))
     return space
+
+
+def searched_fields(space: Mapping[str, Dimension]) -> set[str]:
+    """The ``Params`` fields a search space sets.
+
+    Parameters
+    ----------
+    space : mapping of str to Dimension
+        From :func:`search_space`.
+
+    Returns
+    -------
+    set of str
+        Field names (a vector field once, whether shared or per item).
+    """
+    return {d.target for d in space.values()}
+
+
+def field_values(space: Mapping[str, Dimension], values: Mapping[str, float]) -> dict[str, Any]:
+    """The ``Params`` field values of a candidate's searched values.
+
+    Parameters
+    ----------
+    space : mapping of str to Dimension
+        From :func:`search_space`.
+    values : mapping of str to float
+        Dimension name -> value (an Optuna trial's ``params``).
+
+    Returns
+    -------
+    dict
+        Field -> a float, or a list of floats for a vector field (a shared value repeated on
+        every item).
+
+    Raises
+    ------
+    KeyError
+        A dimension of the space without a value.
+    """
+    out: dict[str, Any] = {}
+    for name, d in space.items():
+        v = float(values[name])
+        if d.size == 0:
+            out[name] = v
+        elif d.item is None:
+            out[d.target] = [v] * d.size
+        else:
+            out.setdefault(d.target, [math.nan] * d.size)[d.item] = v
+    return out
 
 
 def distributions(space: Mapping[str, Dimension]) -> dict[str, Any]:

@@ -20,9 +20,10 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 from .objective import candidate_table, evaluate, split_specs
-from .space import Dimension, constraint_violations, distributions, search_space
+from .space import Dimension, constraint_violations, distributions, field_values, search_space, searched_fields
 
-__all__ = ["SAMPLERS", "STUDY_NAME", "TrialJob", "TuneResult", "add_trials", "controller_base", "trial_seed", "tune"]
+__all__ = ["SAMPLERS", "STUDY_NAME", "TrialJob", "TuneResult", "add_trials", "controller_base", "designed_base",
+           "trial_seed", "tune"]
 
 SAMPLERS = ("tpe", "cmaes")
 STUDY_NAME = "tune"
@@ -38,7 +39,9 @@ class TuneResult:
     controller : dict
         The base ``[controller]`` table tuned.
     suite, split : str
-        The suite's name and version, and the split tuned on.
+        The suite's name and the split tuned on.
+    suite_version : int
+        The suite file's ``version``.
     trials : int
         Trials finished (complete, pruned, or refused by a constraint).
     complete, pruned, refused : int
@@ -49,6 +52,9 @@ class TuneResult:
         CPU and wall time of this process's trials.
     best_params : dict
         Gains of the best complete trial (empty if none completed).
+    table : dict
+        The best candidate's whole ``[controller]`` table: its gains and every unsearched field
+        (:func:`designed_base`); empty if none completed.
     best_score : float
         Its training score (mean benchmark run score; NaN if none completed).
     validation_score : float
@@ -59,7 +65,9 @@ class TuneResult:
         Runs of the split one trial flies (the budget is trials x runs_per_trial).
     study_cost : dict
         Runs, RK4 steps, CPU and wall seconds summed over every finished trial of the study (all
-        the processes that added to it; trials recorded before this accounting existed excluded).
+        the processes that added to it; trials recorded before this accounting existed excluded),
+        and ``elapsed_s``: the wall time of every ``tune`` call on the study, summed (a resumed
+        tuning's cost is the whole study's, not the last call's).
     validation_runs : list of dict
         The best gains' validation runs: task, tier, seed index, status, cause, t_stop, score.
     outputs : dict
@@ -69,6 +77,7 @@ class TuneResult:
     controller: dict
     suite: str
     split: str
+    suite_version: int = 0
     trials: int = 0
     complete: int = 0
     pruned: int = 0
@@ -78,6 +87,7 @@ class TuneResult:
     cpu_s: float = 0.0
     wall_s: float = 0.0
     best_params: dict = field(default_factory=dict)
+    table: dict = field(default_factory=dict)
     best_score: float = math.nan
     validation_score: float = math.nan
     study: str = ""
@@ -285,7 +295,7 @@ class TrialJob:
     Attributes
     ----------
     base : dict
-        The ``[controller]`` table tuned.
+        The ``[controller]`` table the candidates are built on (:func:`designed_base`).
     suite : str
         Suite name or absolute file path.
     split : str
@@ -318,12 +328,45 @@ class TrialJob:
     chunk: int | None = None
 
 
+def designed_base(spec, base: Mapping[str, Any], space: Mapping[str, Dimension]) -> dict:
+    """The ``[controller]`` table every candidate is built on: each unsearched field at its designed value.
+
+    The bare table ``base`` resolves, for the run ``spec``, to the controller the suite flies
+    untuned (designed for the vehicle when it has a reach, :mod:`auvtrack.scenario.designed`:
+    e.g. ``saturation = "compensated"``).  Every field of it that the search does not set
+    (numeric or not) is copied into the table, so a candidate differs from that controller in
+    the searched gains only, and a preset of the table reproduces the tuned controller.
+
+    Parameters
+    ----------
+    spec : RunSpec
+        A run of the split with the bare ``[controller]`` table (the split's first: designed
+        values depend on the run's vehicle speed, so the candidates take one run's).
+    base : mapping
+        The bare table (``kind``, and ``module`` for a plug-in).
+    space : mapping of str to Dimension
+        The search space (its fields are left out).
+
+    Returns
+    -------
+    dict
+        ``base`` with every unsearched field (a plug-in's under ``params``).
+    """
+    from ..scenario import load_scenario
+
+    searched = searched_fields(space)
+    section = load_scenario(spec.raw, spec.overrides).to_dict()["controller"]
+    if section.get("kind") == "plugin":
+        params = {k: v for k, v in (section.get("params") or {}).items() if k not in searched}
+        return {**dict(base), "params": params}
+    return {**dict(base), **{k: v for k, v in section.items() if k not in searched}}
+
+
 def untuned_gains(spec, space: Mapping[str, Dimension]) -> dict[str, float]:
     """The tunable gains a bare ``[controller]`` table resolves to for the run's vehicle, in the space.
 
-    A candidate holding them is flown with the law's defaults for its other fields (a table with
-    gains given is not designed, :mod:`auvtrack.scenario.designed`), e.g. the published
-    saturation form where the bare table gets the compensated one.
+    With :func:`designed_base`'s other fields, a candidate holding them is the controller the
+    bare table flies on ``spec`` (up to the clipping to the space).
 
     Parameters
     ----------
@@ -335,7 +378,7 @@ def untuned_gains(spec, space: Mapping[str, Dimension]) -> dict[str, float]:
     Returns
     -------
     dict of str to float
-        One value per tunable gain.
+        One value per dimension: a vector field's item, or the mean of its items when shared.
     """
     from ..scenario import load_scenario
 
@@ -345,8 +388,9 @@ def untuned_gains(spec, space: Mapping[str, Dimension]) -> dict[str, float]:
     out = {}
     for k, d in space.items():
         try:
-            v = float(get(k))
-        except (AttributeError, KeyError, TypeError):
+            v = get(d.target)
+            v = float(v) if d.size == 0 else (float(v[d.item]) if d.item is not None else math.fsum(v) / len(v))
+        except (AttributeError, KeyError, TypeError, IndexError):
             v = d.default
         out[k] = min(max(v, d.low), d.high)
     return out
@@ -386,15 +430,14 @@ def _running(study) -> list:
     return study.get_trials(deepcopy=False, states=(TrialState.RUNNING,))
 
 
-def _fly(study, trial, job: TrialJob, st, cost: dict) -> None:
+def _fly(study, trial, job: TrialJob, st, cost: dict, space: Mapping[str, Dimension]) -> None:
     """Fly one asked trial on the split (or refuse it on a set-up condition) and tell the study."""
     import optuna
 
     from ..scenario import load_scenario
 
     w0, c0 = time.perf_counter(), time.process_time()
-    gains = dict(trial.params)
-    table = candidate_table(job.base, gains)
+    table = candidate_table(job.base, field_values(space, trial.params))
     specs = split_specs(st, table, job.split)
     problems = constraint_violations(load_scenario(specs[0].raw, specs[0].overrides))
     if problems:
@@ -403,6 +446,8 @@ def _fly(study, trial, job: TrialJob, st, cost: dict) -> None:
         trial.set_user_attr("constraint", problems)
         if job.sampler == "tpe":  # CMA-ES has no constraint handling: it sees the failure score only
             trial.set_constraint("setup", float(len(problems)))
+        trial.set_user_attr("wall_s", time.perf_counter() - w0)
+        trial.set_user_attr("cpu_s", time.process_time() - c0)
         study.tell(trial, st.file.run_score.cap + 2.0)
     else:
         trial.set_user_attr("violations", 0)
@@ -460,7 +505,8 @@ def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
 
     st = load_suite(job.suite)
     study = load_study(job.study, job.sampler, job.seed)
-    dists = distributions(search_space(_params_model(job.base)))
+    space = search_space(_params_model(job.base))
+    dists = distributions(space)
     cost = {"runs": 0, "steps": 0, "cpu_s": 0.0}
     while len(finished_trials(study)) + len(_running(study)) < job.trials:
         with asking(job.study):
@@ -475,7 +521,7 @@ def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
                 break
         c0 = time.process_time()
         try:
-            _fly(study, trial, job, st, cost)
+            _fly(study, trial, job, st, cost, space)
         except BaseException:  # a stop: the trial's gains are asked again when the tuning resumes
             with asking(job.study):
                 _give_back(study, trial)
@@ -556,18 +602,20 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
         probe_scheduler(scheduler)  # one line, before anything is stored
     st = load_suite(suite)
     probe = split_specs(st, base, split)  # refuses the evaluation split before anything is stored
+    fixed = designed_base(probe[0], base, space)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     study, url = _open_study(out, sampler, seed)
     study.set_user_attr("controller", base)
-    study.set_user_attr("suite", f"{st.name} v{st.file.version}")
+    study.set_user_attr("suite", st.name)
+    study.set_user_attr("suite_version", st.file.version)
     with asking(url):
         _requeue_interrupted(study)
         if not study.get_trials(deepcopy=False):  # the first candidate: the untuned (designed) gains
             study.enqueue_trial(untuned_gains(probe[0], space), user_attrs={"first_candidate": "untuned"})
     suite_ref = str(Path(suite).resolve()) if Path(str(suite)).suffix == ".toml" else str(suite)
-    job = TrialJob(base, suite_ref, split, trials, url, sampler, seed, workers, backend, chunk)
-    res = TuneResult(controller=base, suite=f"{st.name} v{st.file.version}", split=split, study=url)
+    job = TrialJob(fixed, suite_ref, split, trials, url, sampler, seed, workers, backend, chunk)
+    res = TuneResult(controller=base, suite=st.name, suite_version=st.file.version, split=split, study=url)
     t_wall, t_cpu = time.perf_counter(), time.process_time()
     if parallel == 1 and scheduler is None and client is None:
         costs = [add_trials(job, 0, progress)]
@@ -577,9 +625,13 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
     res.steps = sum(c["steps"] for c in costs)
     res.wall_s = time.perf_counter() - t_wall
     res.cpu_s = time.process_time() - t_cpu if len(costs) == 1 and parallel == 1 else sum(c["cpu_s"] for c in costs)
-    _summarise(load_study(url, sampler, seed), res)
+    final = load_study(url, sampler, seed)
+    final.set_user_attr("elapsed_s", float(final.user_attrs.get("elapsed_s", 0.0)) + res.wall_s)
+    _summarise(final, res)
+    if res.best_params:
+        res.table = candidate_table(fixed, field_values(space, res.best_params))
     if validate and res.best_params and st.file.splits.validation is not None:
-        ev = evaluate(st, split_specs(st, candidate_table(base, res.best_params), "validation"),
+        ev = evaluate(st, split_specs(st, res.table, "validation"),
                       workers=workers, backend=backend)
         res.validation_score = ev.score
         res.validation_runs = [{**{k: r[k] for k in ("task", "tier", "seed_index", "status", "cause", "t_stop")},
@@ -603,6 +655,7 @@ def _summarise(study, res: TuneResult) -> None:
     res.pruned = sum(t.state == TrialState.PRUNED for t in done)
     res.study_cost = {k: sum(t.user_attrs.get(k, 0) for t in done) for k in ("runs", "steps", "cpu_s", "wall_s")
                       if k in ("runs", "steps") or any(k in t.user_attrs for t in done)}
+    res.study_cost["elapsed_s"] = float(study.user_attrs.get("elapsed_s", res.wall_s))
     ok = [t for t in done if t.state == TrialState.COMPLETE and not t.user_attrs.get("violations")]
     if ok:
         best = min(ok, key=lambda t: (t.value, t.number))

@@ -142,3 +142,22 @@ def test_gains_the_controller_refuses_are_an_error_the_objective_penalises():
         tuning.run_cost(case, "pid", {"kp": 1.0, "ki": 5.0, "kd": 1.0}, 1.0, 0.002, tuning.Objective())
     with pytest.raises(ValueError, match="controller.k2"):  # below the Moreno-Osorio bound
         tuning.run_cost(case, "sta", {"lam": 1.0, "k1": 1.0, "k2": 0.05}, 1.0, 0.002, tuning.Objective())
+
+
+def test_the_first_candidate_is_the_defaults_and_refused_ones_are_not_flown(monkeypatch):
+    from auvtrack.tuning.space import constraint_violations
+
+    flown = []
+    real = tuning.run_cost
+
+    def recording(case, kind, gains, duration, dt, objective):
+        flown.append(dict(gains))
+        return real(case, kind, gains, duration, dt, objective)
+
+    monkeypatch.setattr(tuning, "run_cost", recording)
+    res = tuning.tune("pid", TINY, workers=1)
+    assert flown[0] == tuning.SPACES["pid"].defaults()  # trial 0
+    assert res.nfev == TINY.evaluations(3) == 18
+    for gains in flown:  # a candidate is flown only when the set-up conditions admit it
+        sc = load_scenario(tuning.case_scenario(tuning.TRAIN_CASES[0], "pid", gains, TINY.duration, TINY.dt))
+        assert constraint_violations(sc) == []

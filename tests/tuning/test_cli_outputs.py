@@ -35,9 +35,12 @@ def test_the_preset_is_usable_as_controller_preset(tuned, monkeypatch):
     monkeypatch.setattr(gain_presets, "_gains_root", lambda: out)
     preset = gain_presets.get_gain_preset("pid_remus100_tiny")
     results = json.loads((out / "results.json").read_text())
-    assert preset.kind == "pid" and preset.gains == results["result"]["best_params"]
+    table = results["result"]["table"]  # the searched gains and every other field of the tuned controller
+    assert preset.kind == "pid" and preset.gains == {k: v for k, v in table.items() if k != "kind"}
+    assert {k: preset.gains[k] for k in results["result"]["best_params"]} == results["result"]["best_params"]
+    assert preset.gains["saturation"] == "compensated"  # the designed form of the REMUS, not the law's default
     for key in ("suite", "split", "budget_runs", "sampler", "sampler_seed", "optuna", "auvtrack", "source_hash",
-                "train_score", "validation_score", "cpu_s", "wall_s", "rk4_steps"):
+                "train_score", "validation_score", "cpu_s", "wall_s", "study_runs", "study_rk4_steps", "suite_version"):
         assert key in preset.provenance, key
     assert preset.provenance["budget_runs"] == 3 * preset.provenance["runs_per_trial"]
     sc = load_scenario(paper_scenario_path(), ['controller={kind="pid", preset="pid_remus100_tiny"}'])
@@ -59,3 +62,25 @@ def test_bad_input_is_one_line(tuned, tmp_path, args, field):
     r = CliRunner().invoke(cli, ["tune", "--suite", str(root / "tiny.toml"), "--out", str(tmp_path / "x"), *args])
     assert r.exit_code == 2 and field in r.output and "Traceback" not in r.output
     assert not (tmp_path / "x").exists()  # refused before anything is stored
+
+
+def test_the_slices_are_the_studys_trials(tuned):
+    import optuna
+
+    from auvtrack.tuning.slices import slice_points
+
+    root, _ = tuned
+    out = root / "out"
+    study = optuna.load_study(study_name="tune", storage=f"sqlite:///{out / 'study.db'}")
+    points = slice_points(study)
+    trials = json.loads((out / "results.json").read_text())["trials"]
+    assert list(points) == ["kp", "ki", "kd", "kaw"]
+    for name, pts in points.items():  # every finished trial once per gain, at its value and score
+        finished = [t for t in trials if t["state"] in ("COMPLETE", "PRUNED")]
+        assert [(p.trial, p.value) for p in pts] == [(t["number"], t["params"][name]) for t in finished]
+        for p, t in zip(pts, finished):
+            if t["state"] == "COMPLETE":
+                assert p.score == t["value"] and p.state == ("refused" if t["user_attrs"]["violations"] else "complete")
+            else:
+                assert p.state == "pruned"
+    assert (out / "figures" / "slices.png").is_file() and "figures/slices.png" in (out / "report.md").read_text()

@@ -66,19 +66,21 @@ def test_bad_tune_input_is_one_line(tiny, tmp_path, capsys, args, words):
     assert words in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
 
 
-def _preset(folder, name, suite, trials):
+def _preset(folder, name, suite, trials, version=1):
     (folder / f"{name}.toml").write_text(
         f'kind = "pid"\ndescription = "x"\n[gains]\nkp = 1.0\n[provenance]\ntool = "auvtrack tune"\n'
-        f'suite = "{suite}"\nbudget_trials = {trials}\n')
+        f'suite = "{suite}"\nsuite_version = {version}\nbudget_trials = {trials}\n')
 
 
 def test_the_shared_budget_is_the_suite_presets_trials(tiny, tmp_path, monkeypatch):
     monkeypatch.setattr(gain_presets, "_gains_root", lambda: tmp_path)
     suite = load_suite(tiny)
-    _preset(tmp_path, "pid_remus100_tiny", "tiny v1", 6)
-    _preset(tmp_path, "pid_remus100_other", "other v1", 9)  # another suite's budget does not count
+    _preset(tmp_path, "pid_remus100_tiny", "tiny", 6)
+    _preset(tmp_path, "pid_remus100_other", "other", 9)  # another suite's budget does not count
+    _preset(tmp_path, "pid_remus100_tiny2", "tiny", 7, version=2)  # nor another version's
+    _preset(tmp_path, "pid_remus100_tinyv1", "tiny v1", 8)  # a suite label "name vN" is not the name
     assert shared_budget(suite) == 6
-    _preset(tmp_path, "ftsmc_remus100_tiny", "tiny v1", 5)
+    _preset(tmp_path, "ftsmc_remus100_tiny", "tiny", 5)
     with pytest.raises(ValueError, match="different budgets"):
         shared_budget(suite)
 
@@ -95,3 +97,20 @@ def test_every_shipped_suite_with_tuned_presets_has_one_shared_budget(name):
         preset = gain_presets.get_gain_preset(f"{k}_remus100_{name}")
         assert preset.kind == k and preset.provenance["split"] == "training"
         assert preset.provenance["budget_runs"] == trials * preset.provenance["runs_per_trial"]
+
+
+def test_the_v2_suite_flies_its_own_presets_and_names_a_missing_one(tmp_path, monkeypatch):
+    from auvtrack.benchmark.suite import resolve_controllers, tracking_kinds
+
+    suite = load_suite("auv-track-v2", check=False)
+    assert suite.file.gain_preset == "{kind}_remus100_auv-track-v2"
+    for e in resolve_controllers(None, gain_preset=suite.file.gain_preset):
+        name = f"{e.label}_remus100_auv-track-v2"
+        if name in gain_presets.available_gain_presets():
+            assert e.table == {"kind": e.label, "preset": name}
+            assert gain_presets.get_gain_preset(name).provenance["suite"] == suite.name
+        else:  # flown untuned, and the entry says which preset is missing
+            assert e.table == {"kind": e.label} and f"no gain preset {name!r} is installed" in e.gains
+    monkeypatch.setattr(gain_presets, "_gains_root", lambda: tmp_path)  # none installed: every entry says so
+    assert all("is installed" in e.gains for e in resolve_controllers(None, gain_preset=suite.file.gain_preset))
+    assert len(tracking_kinds()) == len(resolve_controllers(None, gain_preset=suite.file.gain_preset))

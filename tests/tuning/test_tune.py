@@ -45,7 +45,7 @@ def test_trial_value_is_the_benchmark_score_of_its_runs(suite_path, tmp_path):
 
 
 def test_the_first_candidate_holds_the_untuned_gains(suite_path, tmp_path):
-    # the tiny suite sets no actuator limit, so the saturation form a bare table gets does not matter here
+    # trial 0 is the bare table's controller: its gains and, through designed_base, every other field
     res = tune("pid", suite_path, trials=1, out=tmp_path / "d0", validate=False)
     (state, params, value), = _trials(tmp_path / "d0")
     st = load_suite(suite_path)
@@ -145,3 +145,15 @@ def test_a_running_trial_of_a_live_process_is_not_taken_back(tmp_path):
     assert states[live.number] == "RUNNING" and states[dead.number] == "FAIL"
     waiting = [t for t in s.get_trials() if t.state.name == "WAITING"]
     assert len(waiting) == 1 and s.ask({"x": optuna.distributions.FloatDistribution(0, 1)}).params == dead.params  # asked again with the same gains
+
+
+def test_a_resumed_tuning_reports_the_whole_studys_cost(suite_path, tmp_path):
+    import tomllib
+
+    first = tune("pid", suite_path, trials=2, out=tmp_path / "c", validate=False)
+    again = tune("pid", suite_path, trials=2, out=tmp_path / "c", validate=False)  # nothing left to fly
+    assert again.runs == 0 and first.runs > 0 and again.study_cost["runs"] == first.study_cost["runs"] == first.runs
+    prov = tomllib.loads(again.outputs["preset"].read_text())["provenance"]
+    assert prov["study_runs"] == first.runs and prov["study_rk4_steps"] == first.steps
+    assert prov["wall_s"] >= round(first.wall_s, 3) and prov["cpu_s"] > 0
+    assert (prov["suite"], prov["suite_version"]) == ("tiny", 1)  # name and version, not one "tiny v1" label
