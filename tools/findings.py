@@ -760,7 +760,7 @@ def block_compare_v2(cv: dict) -> str:
             by_cause[k] = by_cause.get(k, 0) + v
     head = (f"`{cv['_provenance']['command']}`, stored {cv['_provenance']['stored']} (sources "
             f"{cv['source_hash'][:12]}): suite {s['name']} version {s['version']}, {s['seeds']} evaluation seeds per "
-            f"cell, {t['runs']} runs in {t['runs_seconds']:.0f} s after {t['compile_seconds']:.0f} s of compilation "
+            f"cell, {t['runs']} runs in {t['runs_seconds']:.0f} s after {t['compile_seconds']:.1f} s of kernel compilation or loading "
             f"({t['batch_backend']}, {t['cpu_count']} cores, load average {t['load_average_start']} at the start, "
             f"{t['load_average_end']} at the end of the runs). Score: the rank-based rule on the weighted criteria "
             f"({', '.join(cv['criteria'])}), lower is better; rank interval: the rule on resampled seeds. "
