@@ -1,6 +1,7 @@
 """Wall time of ``auvtrack compare`` on this machine: ``--quick`` and the default suite, after compilation.
 
-Usage: ``python benchmarks/compare_timing.py [--suite NAME] [--skip-default] [--workers N] [--out DIR] [--backend B ...]``
+Usage: ``python benchmarks/compare_timing.py [--suite NAME] [--skip-default | --default-from DIR] [--workers N]
+[--out DIR] [--backend B ...]``
 (another suite than the default writes ``compare_timing-<suite>.{json,md}``).
 
 A first ``--quick`` comparison compiles every kernel the disk cache lacks, or loads it, and is timed as
@@ -10,7 +11,9 @@ written to ``benchmarks/compare_timing.{json,md}`` are the reports' own timing b
 (``results.json`` -> ``timing``: runs, compilation, analysis, load averages) plus the wall time of
 each ``compare`` call, for each batch back end asked for (``--backend``, default ``threads``; with
 ``simd`` the cold row also compiles the lane kernels the disk cache lacks).  The machine may be
-shared: the load averages are part of the result.
+shared: the load averages are part of the result.  ``--default-from DIR`` takes the default row
+from a finished, not resumed, default comparison in ``DIR`` (its own timing block, the same numbers;
+its wall-time column is then empty) instead of running it again.
 Never used as a timed unit test.
 """
 from __future__ import annotations
@@ -38,12 +41,16 @@ def _one(label: str, out: Path, quick: bool, workers: int | None, backend: str =
          suite: str = DEFAULT_SUITE) -> dict:
     t0 = time.perf_counter()
     res = compare(suite=suite, quick=quick, out=out, workers=workers, progress=True, backend=backend)
-    wall = time.perf_counter() - t0
+    return _row(label, out, time.perf_counter() - t0, res.complete)
+
+
+def _row(label: str, out: Path, wall: float | None, complete: bool) -> dict:
+    """The timing row of the comparison in ``out`` (its ``results.json`` -> ``timing``); ``wall``: the call's wall time."""
     doc = json.loads((out / "results.json").read_text())
     timing = doc["timing"]
     after = timing["runs_seconds"] + timing["analysis_seconds"]
     target = TARGETS[label]
-    label = f"{label}, `{backend}`"
+    label = f"{label}, `{timing['batch_backend']}`"
     runs = pd.read_parquet(out / "runs.parquet", columns=["task", "steps"])
     dt_ = float(doc["suite"]["file"]["base"].get("sim.dt", 0.002))
     full = runs["task"].map(lambda t: round(doc["suite"]["durations"][t] / dt_)).sum()
@@ -51,7 +58,20 @@ def _one(label: str, out: Path, quick: bool, workers: int | None, backend: str =
             "controllers": len(doc["controllers"]), "tiers": len(doc["suite"]["file"]["tiers"]) -
             len(doc["suite"]["skipped_tiers"]), "wall_seconds": wall, "after_compilation_seconds": after,
             "target_seconds": target, "meets_target": None if target is None else after <= target,
-            "steps": int(runs["steps"].sum()), "steps_full": int(full), "source_hash": doc["source_hash"], "complete": res.complete, **timing}
+            "steps": int(runs["steps"].sum()), "steps_full": int(full), "source_hash": doc["source_hash"],
+            "complete": complete, "measured_in": "this call" if wall is not None else "--default-from", **timing}
+
+
+def _existing_default(folder: Path, suite: str) -> dict:
+    """The default row from a finished comparison of ``suite`` in ``folder`` (``--default-from``)."""
+    doc = json.loads((folder / "results.json").read_text())
+    if doc["suite"]["quick"] or doc["suite"]["name"] != Path(suite).stem:
+        raise SystemExit(f"--default-from: {folder} holds {doc['suite']['name']}"
+                         f"{' --quick' if doc['suite']['quick'] else ''}, not the default {suite}")
+    if doc["timing"]["chunks_resumed"]:
+        raise SystemExit(f"--default-from: {folder} was resumed ({doc['timing']['chunks_resumed']} chunks): "
+                         "its runs time is partial")
+    return _row("default", folder, None, True)
 
 
 def _cpu() -> str:
@@ -83,13 +103,21 @@ def _markdown(doc: dict) -> str:
                      f"{r['analysis_seconds']:.1f} | {r['after_compilation_seconds']:.1f} | {tgt} | {ok} | "
                      f"{r['steps'] / r['steps_full']:.2f} | {la} | "
                      f"{lb} |")
-    return "\n".join(lines) + "\n"
+    head = doc["rows"][0]["source_hash"]
+    notes = [f"* {r['variant']}: " + ", ".join(
+        ([f"read from the finished comparison `{r['out']}` (`--default-from`), not run by this call"]
+         if r.get("measured_in") == "--default-from" else [])
+        + ([f"sources {r['source_hash'][:12]}"] if r["source_hash"] != head else []))
+        for r in doc["rows"] if r.get("measured_in") == "--default-from" or r["source_hash"] != head]
+    return "\n".join(lines + ([""] + notes if notes else [])) + "\n"
 
 
 def main() -> None:
     """Run the comparisons and write ``compare_timing.json`` and ``compare_timing.md`` next to this script."""
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--skip-default", action="store_true", help="only the --quick rows")
+    ap.add_argument("--default-from", type=Path, default=None,
+                    help="the default row from this finished comparison's results.json instead of a new run")
     ap.add_argument("--workers", type=int, default=None, help="local threads (default: every core)")
     ap.add_argument("--out", type=Path, default=None, help="folder of the comparisons (default: a new temp dir)")
     ap.add_argument("--backend", action="append", default=None,
@@ -101,8 +129,10 @@ def main() -> None:
     for be in args.backend or ["threads"]:
         rows += [_one("quick (cold)", root / be / "quick-cold", True, args.workers, be, args.suite),
                  _one("quick", root / be / "quick", True, args.workers, be, args.suite)]
-        if not args.skip_default:
+        if not (args.skip_default or args.default_from):
             rows.append(_one("default", root / be / "default", False, args.workers, be, args.suite))
+    if args.default_from and not args.skip_default:
+        rows.append(_existing_default(args.default_from, args.suite))
     doc = {"measured": dt.datetime.now(dt.timezone.utc).isoformat(timespec="minutes"),
            "machine": f"{platform.machine()} / {_cpu()} / Python "
                       f"{platform.python_version()}", "cpu_count": os.cpu_count(), "version": __version__,

@@ -9,6 +9,8 @@ output of the command that owns it (:data:`SOURCES`); nothing is typed by hand. 
     python -m tools.findings store ablation studies/ablation/results.json
     auvtrack study model-gap --out studies/model-gap
     python -m tools.findings store model-gap studies/model-gap/results.json
+    auvtrack compare --suite auv-track-v2 --backend simd --out compare/auv-track-v2
+    python -m tools.findings store compare-v2 compare/auv-track-v2/results.json
     ...                                      # one pair per entry of SOURCES
     python -m tools.findings render   # rewrite the generated blocks
 
@@ -44,6 +46,7 @@ SOURCES: dict[str, str] = {
     "robustness": "auvtrack study robustness --out studies/robustness  (results.json)",
     "realism": "auvtrack study realism --out studies/realism  (results.json)",
     "model-gap": "auvtrack study model-gap --out studies/model-gap  (results.json)",
+    "compare-v2": "auvtrack compare --suite auv-track-v2 --backend simd --out compare/auv-track-v2  (results.json)",
 }
 """Stored result name -> the command whose output it is."""
 
@@ -714,31 +717,76 @@ def _calm_check(cv: dict) -> list[str]:
     return out
 
 
+def _pct_ci(lo: float, hi: float) -> str:
+    return f"[{100 * lo:.1f}, {100 * hi:.1f}] %"
+
+
+def _untuned_text(cv: dict) -> str:
+    """Which competitors' gains were not tuned on the suite (the report's own list)."""
+    untuned = cv.get("not_tuned_on_suite")
+    s = cv["suite"]
+    if untuned is None:
+        return "Whether each preset was tuned on this suite: not recorded in this result."
+    if not untuned:
+        return f"Every competitor's gains were tuned by `auvtrack tune` on {s['name']} v{s['version']}."
+    return (f"**Not tuned on this suite** ({len(untuned)} of {len(cv['controllers'])}): "
+            + ", ".join(f"`{c}`" for c in untuned) + f"; their gains were not tuned by `auvtrack tune` on "
+            f"{s['name']} v{s['version']}, so their rows rank those gains (last column), not the controller at its "
+            "best on this suite.")
+
+
 def block_compare_v2(cv: dict) -> str:
     """The auv-track-v2 leaderboard, its aggregates and the calm-truth acceptance check, from ``compare``'s results.json."""
     s, t = cv["suite"], cv["timing"]
     agg = cv.get("aggregates") or {}
     iqm = (agg.get("estimates") or {}).get("iqm", {})
     pooled = {r["controller"]: r for r in cv["pooled"]}
-    rows = ["| rank | controller | score | rank 95 % CI | failure rate | IQM of normalised `"
+    rows = ["| rank | controller | score | rank 95 % CI | failure rate [Wilson 95 %] | IQM of normalised `"
             f"{agg.get('score', '?')}` [95 %] | gains |", "|---|---|---|---|---|---|---|"]
     gains = {c["label"]: c["gains"] for c in cv["controllers"]}
     for r in cv["leaderboard"]:
         c = r["controller"]
         q = iqm.get(c)
         rows.append(f"| {r['rank']:g} | `{c}` | {r['score']:.2f} | [{r['rank_interval']['low']:g}, "
-                    f"{r['rank_interval']['high']:g}] | {100 * pooled[c]['failure_rate']:.1f} % | "
-                    + (f"{_f(q['point'])} [{_f(q['low'])}, {_f(q['high'])}]" if q else "n/a") + f" | {gains[c]} |")
+                    f"{r['rank_interval']['high']:g}] | {100 * pooled[c]['failure_rate']:.1f} % "
+                    f"{_pct_ci(*pooled[c]['failure_ci'])} | "
+                    + (f"{_f(q['point'])} [{_f(q['low'])}, {_f(q['high'])}]" if q and q["point"] is not None
+                       else "not finite") + f" | {gains[c]} |")
     fails = sum(r["failures"] for r in cv["pooled"])
     unknown = sum(r["causes"].get("unknown", 0) for r in cv["pooled"])
+    by_cause: dict[str, int] = {}
+    for r in cv["pooled"]:
+        for k, v in r["causes"].items():
+            by_cause[k] = by_cause.get(k, 0) + v
     head = (f"`{cv['_provenance']['command']}`, stored {cv['_provenance']['stored']} (sources "
-            f"{cv['source_hash'][:12]}): suite {s['name']} version {s['version']}, {s['seeds']} seeds per cell, "
-            f"{t['runs']} runs in {t['runs_seconds']:.0f} s after {t['compile_seconds']:.0f} s of compilation "
-            f"({t['batch_backend']}, {t['cpu_count']} cores, load average {t['load_average_start']} at the start). "
-            f"Score: the rank-based rule on the weighted criteria ({', '.join(cv['criteria'])}); normalisation of "
-            f"the aggregates: {agg.get('normalisation', 'none')}.")
-    tail = [f"{fails} runs failed, {unknown} of them without a recorded cause."] + _calm_check(cv)
+            f"{cv['source_hash'][:12]}): suite {s['name']} version {s['version']}, {s['seeds']} evaluation seeds per "
+            f"cell, {t['runs']} runs in {t['runs_seconds']:.0f} s after {t['compile_seconds']:.1f} s of kernel compilation or loading "
+            f"({t['batch_backend']}, {t['cpu_count']} cores, load average {t['load_average_start']} at the start, "
+            f"{t['load_average_end']} at the end of the runs). Score: the rank-based rule on the weighted criteria "
+            f"({', '.join(cv['criteria'])}), lower is better; rank interval: the rule on resampled seeds. "
+            f"Normalisation of the aggregates: {agg.get('normalisation', 'none')}; IQM with "
+            f"{agg.get('n_resamples', '?')} stratified-bootstrap replicates (strata: {', '.join(agg.get('strata', []))}); "
+            "not finite when more than a quarter of a controller's runs failed (a failed run is `inf`).")
+    tail = [_untuned_text(cv), "",
+            f"{fails} runs failed, {unknown} of them without a recorded cause"
+            + (" (by cause: " + ", ".join(f"{k} {v}" for k, v in sorted(by_cause.items())) + ")" if by_cause else "")
+            + "; per tier and controller: the report's *Why it failed* table.", ""] + _calm_check(cv)
     return head + "\n\n" + "\n".join(rows) + "\n\n" + "\n".join(tail)
+
+
+def block_readme_compare_v2(cv: dict) -> str:
+    """README's pointer to the auv-track-v2 leaderboard: its order and conditions, from ``compare``'s results.json."""
+    s = cv["suite"]
+    pooled = {r["controller"]: r for r in cv["pooled"]}
+    order = ", ".join(f"`{r['controller']}` {r['score']:.2f} ({100 * pooled[r['controller']]['failure_rate']:.1f} % "
+                      "failed)" for r in cv["leaderboard"])
+    return (f"**Benchmark `{s['name']}`** (version {s['version']}, {cv['timing']['runs']} runs: "
+            f"{len(cv['controllers'])} controllers x {len(s['durations'])} tasks x "
+            f"{len(s['file']['tiers']) - len(s['skipped_tiers'])} tiers x {s['seeds']} evaluation seeds, each controller "
+            f"with its gain preset as named there; stored {cv['_provenance']['stored']}): overall score, lower is "
+            f"better: {order}. Rank intervals, the aggregates across tasks, the calm-truth acceptance check and the "
+            "conditions: [docs/findings.md](docs/findings.md) §8; the full report: `auvtrack compare --suite "
+            f"{s['name']}`.")
 
 
 # ------------------------------------------------------------------ rendering
@@ -755,11 +803,13 @@ def blocks() -> dict[str, tuple[str, Callable[[], str]]]:
         "realism": ("findings", lambda: block_realism(load("realism"))),
         "remus-u0": ("findings", lambda: block_remus_u0(load("robustness"), load("realism"))),
         "model-gap": ("findings", lambda: block_model_gap(load("model-gap"))),
+        "compare-v2": ("findings", lambda: block_compare_v2(load("compare-v2"))),
         "provenance": ("findings", lambda: block_provenance(list(SOURCES))),
         "readme-performance": ("readme", lambda: block_performance(json.loads(BENCH.read_text()))),
         "readme-reproduction": ("readme", lambda: block_readme(load("reproduce"), load("ablation"),
                                                                load("fixed-time"), load("realism"),
                                                                load("model-gap"))),
+        "readme-benchmark": ("readme", lambda: block_readme_compare_v2(load("compare-v2"))),
     }
 
 
@@ -801,7 +851,11 @@ def main(argv: list[str] | None = None) -> int:
     """``python -m tools.findings store NAME PATH | render | check``."""
     args = sys.argv[1:] if argv is None else argv
     if args[:1] == ["store"] and len(args) == 3:
-        print(store(args[1], args[2]))
+        try:
+            print(store(args[1], args[2]))
+        except KeyError as exc:
+            print(f"store: NAME: {exc.args[0]}", file=sys.stderr)
+            return 2
         return 0
     if args == ["render"]:
         print("changed:", ", ".join(render()) or "nothing")

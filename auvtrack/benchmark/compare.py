@@ -170,7 +170,7 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
             backend: str | None = None, resume: bool = False,
             progress: bool = True, max_chunks: int | None = None, chunk_size: int = 48,
             entries: Sequence[ControllerEntry] | None = None, max_runs: int = runner.DEFAULT_MAX_RUNS,
-            notify: Any = None) -> CompareOutcome:
+            notify: Any = None, tuned_dir: str | Path | None = None) -> CompareOutcome:
     """Run a benchmark comparison and write its report.
 
     Parameters
@@ -209,6 +209,9 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
         Refuse a plan of more runs (``--max-runs``), before anything is planned.
     notify : callable, optional
         Receives the one-line notices of the execution (chunks that failed verification).
+    tuned_dir : str or Path, optional
+        Where ``compare --tune`` tuned the plug-ins (``<out>-tune``): the report's tuning table reads
+        their tuning there.
 
     Returns
     -------
@@ -246,5 +249,6 @@ def compare(suite: str | Path | Suite = DEFAULT_SUITE, *, controllers: Sequence[
               "chunks_resumed": ex.chunks_skipped, "runs": ex.runs, "backend": "dask" if (scheduler or client)
               else "local threads", "workers": workers, "batch_backend": backend or _default_backend(), "cpu_count": os.cpu_count(),
               "load_average_start": load0, "load_average_end": load1}
-    report = write_report(folder, s, ents, df, analysis, seeds, reps, timing, t0)
+    report = write_report(folder, s, ents, df, analysis, seeds, reps, timing, t0,
+                          None if tuned_dir is None else Path(tuned_dir))
     return CompareOutcome(folder, True, report, ex, time.perf_counter() - t0)

@@ -16,7 +16,7 @@ import numpy as np
 
 from .leaderboard import metric_info
 from .report_aggregates import write_aggregates_section
-from .report_competitors import TUNING_COLUMNS, failure_cause_rows, gain_rows, tuning_rows
+from .report_competitors import TUNING_COLUMNS, failure_cause_rows, gain_rows, not_tuned_on, tuning_rows
 from ..report import Report, fmt, write_json
 from .suite import ControllerEntry, Suite
 
@@ -36,6 +36,17 @@ def _ci(lo: float, hi: float, digits: int = 3) -> str:
 
 def _pct(x: float) -> str:
     return f"{100.0 * x:.1f} %"
+
+
+def _pct_ci(lo: float, hi: float) -> str:
+    """A rate's interval in percent, as the rate beside it."""
+    return f"[{100.0 * lo:.1f}, {100.0 * hi:.1f}] %"
+
+
+def _header(metric: str) -> str:
+    """A metric's column head with its unit and interval."""
+    unit = metric_info(metric)[1]
+    return f"{metric} ({unit}) median [95 % bootstrap]" if unit and unit != "-" else f"{metric} median [95 % bootstrap]"
 
 
 def figure_leaderboard(analysis: Mapping, tiers: Sequence[str]):
@@ -175,7 +186,7 @@ def _cell_rows(analysis: Mapping, tier: str, controllers: Sequence[str], tasks: 
     for task in tasks:
         for ctrl in controllers:
             c = cells[(tier, task, ctrl)]
-            row = [task, ctrl, f"{c['failures']}/{c['n']} {_ci(*c['failure_ci'], 2)}"]
+            row = [task, ctrl, f"{c['failures']}/{c['n']} {_pct_ci(*c['failure_ci'])}"]
             for m in analysis["metrics"]:
                 row.append(f"{fmt(c[m]['median'], 3)} {_ci(c[m]['low'], c[m]['high'])}")
             row.append(scores[f"{tier}/{task}"][ctrl]["score"])
@@ -211,7 +222,8 @@ def _load(avg) -> str:
 
 
 def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df, analysis: Mapping,
-                 seeds: Mapping, reps: Mapping, timing: dict, t_analysis0: float) -> Path:
+                 seeds: Mapping, reps: Mapping, timing: dict, t_analysis0: float,
+                 tuned_dir: Path | None = None) -> Path:
     """Write ``report.md`` (and ``report.html``), ``results.json`` and the figures under ``out``.
 
     Parameters
@@ -234,6 +246,8 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
         Execution timing (recorded under ``timing`` in ``results.json``).
     t_analysis0 : float
         ``time.perf_counter()`` when the analysis started.
+    tuned_dir : Path, optional
+        Where ``compare --tune`` tuned the plug-ins (their rows of the tuning table).
 
     Returns
     -------
@@ -267,17 +281,25 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
     for c in order:
         ri = analysis["rank_intervals"][c]
         p = pooled[c]
-        rows.append([scores["overall"][c]["rank"], c, scores["overall"][c]["score"],
+        rows.append([scores["overall"][c]["rank"], c, f"{scores['overall'][c]['score']:.2f}",
                      f"[{ri['low']:g}, {ri['high']:g}]", ri["p_best"]]
                     + [f"{scores['tiers'][t][c]['score']:.2f} ({scores['tiers'][t][c]['rank']:g})" for t in tiers]
-                    + [f"{_pct(p['failure_rate'])} {_ci(*p['failure_ci'], 2)}"])
+                    + [f"{_pct(p['failure_rate'])} {_pct_ci(*p['failure_ci'])}"])
     rep.table(["rank", "controller", "score", "rank 95 % CI", "P(best)"] + [f"{t} score (rank)" for t in tiers]
-              + ["failure rate, all runs"], rows, digits=3)
+              + ["failure rate, all runs [Wilson 95 %]"], rows, digits=3)
     rep.paragraph("Score: in every (tier, task) cell the controllers are ranked on the failure rate and on "
                   "the median of each metric (a failed run counts as worse than any completed one; ties share "
                   "their average rank); the cell score is the weighted mean of these ranks, a tier's score the "
                   "mean over its tasks, the overall score the mean over the tiers. Lower is better. Rank "
                   "interval and P(best): the rule applied to resamples of the seed indices.")
+    tuning = tuning_rows(entries, tuned_dir)
+    suite_id = f"{suite.name} v{suite.file.version}"
+    untuned = not_tuned_on(tuning, suite_id)
+    if untuned:
+        rep.paragraph(f"**Not tuned on this suite** ({len(untuned)} of {len(entries)}): " + ", ".join(
+            f"`{c}`" for c in untuned) + f". Their gains were not tuned by `auvtrack tune` on {suite_id}'s training "
+            "split (the tuning table below says where they come from); their rows rank those gains, not the "
+            "controller at its best on this suite.")
     rep.figure(figure_leaderboard(analysis, tiers), "leaderboard", "Overall and per-tier scores; rank intervals")
     write_aggregates_section(rep, analysis["aggregates"], order)
 
@@ -288,7 +310,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
         rep.paragraph("Controllers without a tuned gain preset run with their package defaults (above).")
     rep.paragraph("Tuning of each competitor, from its gain preset's provenance (`auvtrack tune` writes it; "
                   "docs/tuning.md): what it was tuned on, the budget and what it cost.")
-    rep.table(list(TUNING_COLUMNS), tuning_rows(entries))
+    rep.table(list(TUNING_COLUMNS), tuning)
     gains = gain_rows(entries)
     if gains:
         rep.paragraph("Gains the presets change, next to the published values (the controllers' defaults, "
@@ -305,7 +327,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
     for r in analysis["pooled_tier"]:
         causes = ", ".join(f"{k} {v}" for k, v in r["causes"].items()) or "none"
         rows.append([r["tier"], r["controller"], f"{r['failures']}/{r['n']}", _pct(r["failure_rate"]),
-                     _ci(*r["failure_ci"], 3), causes])
+                     _pct_ci(*r["failure_ci"]), causes])
     rep.table(["tier", "controller", "failed", "rate", "Wilson 95 %", "causes"], rows)
     head, why = failure_cause_rows(analysis["pooled_tier"])
     if why:
@@ -322,7 +344,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
     for t in tiers:
         rep.heading(f"Tier `{t}`")
         rep.paragraph(suite.file.tiers[t].description)
-        rep.table(["task", "controller", "failed [Wilson]"] + [f"{m} median [bootstrap]" for m in metrics]
+        rep.table(["task", "controller", "failed [Wilson 95 %]"] + [_header(m) for m in metrics]
                   + ["cell score"], _cell_rows(analysis, t, order, tasks), digits=3)
         prs = _paired_rows(analysis, t, primary, "wilcoxon")
         if prs:
@@ -369,6 +391,7 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
         "leaderboard": [{"controller": c, **scores["overall"][c], "rank_interval": analysis["rank_intervals"][c],
                          "tiers": {t: scores["tiers"][t][c] for t in tiers}} for c in order],
         "representative_seeds": {f"{k[0]}/{k[1]}": v for k, v in seeds.items()},
+        "tuning": [dict(zip(TUNING_COLUMNS, r)) for r in tuning], "not_tuned_on_suite": untuned,
         **{k: analysis[k] for k in ("cells", "pooled_tier", "pooled", "scores", "weights", "paired", "aggregates")},
         "timing": timing,
     })

@@ -1,7 +1,8 @@
 """The report's tables on the competitors and their failures: tuning budget and cost, gains, causes.
 
 * :func:`tuning_rows`: each competitor's gain preset and its ``[provenance]`` (the tool, the
-  suite and split it was tuned on, the budget and what it cost), or the package defaults;
+  suite and split it was tuned on, the budget and what it cost), a plug-in's ``compare --tune``
+  tuning, or the package defaults; :func:`not_tuned_on`: those not tuned on the suite compared;
 * :func:`gain_rows`: the gains a preset changes, next to the published values (the controller's
   ``Params`` defaults, docs/controllers.md);
 * :func:`failure_cause_rows`: "why it failed": the failed runs per (tier, controller) by cause;
@@ -9,12 +10,14 @@
 """
 from __future__ import annotations
 
+import json
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from ..report import fmt
 from .suite import ControllerEntry
 
-__all__ = ["tuning_rows", "gain_rows", "failure_cause_rows", "TUNING_COLUMNS"]
+__all__ = ["tuning_rows", "not_tuned_on", "gain_rows", "failure_cause_rows", "TUNING_COLUMNS"]
 
 TUNING_COLUMNS = ("competitor", "gains", "tuned by", "tuned on", "budget", "cost", "objective (train / validation)")
 _UNKNOWN = "unknown"
@@ -53,13 +56,24 @@ def _objective(p: Mapping[str, Any]) -> str:
     return "n/a"
 
 
-def tuning_rows(entries: Sequence[ControllerEntry]) -> list[list[str]]:
+def _plugin_tuning(entry: ControllerEntry, tuned_dir: Path | None) -> Mapping[str, Any] | None:
+    """The provenance of a plug-in's ``compare --tune`` tuning (``<tuned_dir>/<label>/results.json``), if it ran."""
+    path = None if tuned_dir is None else Path(tuned_dir) / entry.label / "results.json"
+    if path is None or "params" not in entry.table or not path.is_file():
+        return None
+    return json.loads(path.read_text()).get("provenance")
+
+
+def tuning_rows(entries: Sequence[ControllerEntry], tuned_dir: Path | None = None) -> list[list[str]]:
     """One row per competitor (:data:`TUNING_COLUMNS`) from its gain preset's provenance.
 
     Parameters
     ----------
     entries : sequence of ControllerEntry
         The competitors.
+    tuned_dir : Path, optional
+        Where ``compare --tune`` tuned the plug-ins (``<out>-tune``): a plug-in entering with tuned
+        ``params`` takes its row from the provenance of that tuning.
 
     Returns
     -------
@@ -69,17 +83,39 @@ def tuning_rows(entries: Sequence[ControllerEntry]) -> list[list[str]]:
     """
     rows = []
     for e in entries:
-        preset = None if e.table.get("kind") == "plugin" else _preset(e)
-        if preset is None:
-            what = "plug-in Params defaults" if e.table.get("kind") == "plugin" else "package defaults"
+        plugin = e.table.get("kind") == "plugin"
+        p = _plugin_tuning(e, tuned_dir) if plugin else None
+        preset = None if plugin else _preset(e)
+        if p is None and preset is None:
+            what = "plug-in Params defaults" if plugin else "package defaults"
             rows.append([e.label, what, "not tuned", "", "0", "", ""])
             continue
-        p = preset.provenance
+        if p is None:
+            p = preset.provenance
         tool = str(p.get("tool") or p.get("study") or "not recorded")
         on = f"{p['suite']}, {p.get('split', '?')} split" if "suite" in p else \
             ", ".join(map(str, p.get("train_cases", []))) or "not recorded"
-        rows.append([e.label, f"preset {preset.name}", tool, on, _budget(p), _cost(p), _objective(p)])
+        gains = "tuned params (`compare --tune`)" if preset is None else f"preset {preset.name}"
+        rows.append([e.label, gains, tool, on, _budget(p), _cost(p), _objective(p)])
     return rows
+
+
+def not_tuned_on(rows: Sequence[Sequence[str]], suite: str) -> list[str]:
+    """Competitors of :func:`tuning_rows` whose gains were not tuned on ``suite`` ("<name> v<version>").
+
+    Parameters
+    ----------
+    rows : sequence of rows
+        :func:`tuning_rows`.
+    suite : str
+        The suite as tuning names it (``auvtrack tune`` provenance ``suite``).
+
+    Returns
+    -------
+    list of str
+        Their labels, in the rows' order.
+    """
+    return [r[0] for r in rows if r[2] != "auvtrack tune" or not str(r[3]).startswith(f"{suite}, ")]
 
 
 def gain_rows(entries: Sequence[ControllerEntry]) -> list[list[str]]:

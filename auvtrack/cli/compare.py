@@ -126,16 +126,17 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
                            tune_budget)
     with stop_once():  # Ctrl-C or SIGTERM: stop once, the finished chunks stay for --resume
         try:
-            entries = None
+            entries, tuned_dir = None, None
             if tune_budget is not None:
-                from ..tuning.newcomer import tuned_entries
+                from ..tuning.newcomer import tune_folder, tuned_entries
 
+                tuned_dir = tune_folder(folder)
                 try:
                     entries = tuned_entries(suite, names, plugins, tune_budget, folder, progress=click.echo)
                 except ValueError as exc:  # one line naming --tune (a SuiteError is one too)
                     raise BadInput(one_line(exc)) from None
             res = _compare(suite, controllers=names, plugins=list(plugins), out=folder, scheduler=scheduler,
-                           entries=entries,
+                           entries=entries, tuned_dir=tuned_dir,
                            workers=workers, backend=backend, resume=resume, max_chunks=max_chunks,
                            max_runs=DEFAULT_MAX_RUNS if max_runs is None else max_runs, progress=not quiet)
         except (SuiteError, CompareError) as exc:

@@ -207,6 +207,33 @@ def test_tuning_and_gain_tables_read_the_presets_provenance():
     assert all(r[0] == "pid" for r in gains)
 
 
+def test_a_tuned_plugin_shows_its_tuning_and_untuned_competitors_are_named(tmp_path):
+    """A plug-in entering ``compare --tune`` with tuned params takes its row from that tuning's provenance
+    (not "not tuned", budget 0); ``not_tuned_on`` names every competitor not tuned on the suite compared."""
+    import json
+
+    from auvtrack.benchmark.report_competitors import not_tuned_on, tuning_rows
+    from auvtrack.benchmark.suite import ControllerEntry, resolve_controllers
+
+    entries = resolve_controllers(["pid", "sta"], None, "{kind}_remus100_auv-track-v1")
+    prov = {"tool": "auvtrack tune", "suite": "auv-track-v1 v1", "split": "training", "budget_trials": 8,
+            "runs_per_trial": 20, "budget_runs": 160, "train_score": 0.5, "validation_score": 0.6,
+            "study_runs": 150, "wall_s": 12.0}
+    tuned = ControllerEntry("mine", {"kind": "plugin", "module": "mine.py", "params": {"kp": 2.0}}, "tuned", "d")
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "results.json").write_text(json.dumps({"provenance": prov}))
+    untuned = ControllerEntry("raw", {"kind": "plugin", "module": "raw.py"}, "defaults", "e")
+    rows = {r[0]: r for r in tuning_rows([*entries, tuned, untuned], tmp_path)}
+    assert rows["mine"][2:5] == ["auvtrack tune", "auv-track-v1 v1, training split", "8 trials x 20 runs = 160 runs"]
+    assert rows["mine"][6] == "0.5 / 0.6" and "150 runs flown" in rows["mine"][5]
+    assert rows["raw"][1:3] == ["plug-in Params defaults", "not tuned"]
+    assert tuning_rows([tuned], None)[0][1:3] == ["plug-in Params defaults", "not tuned"]  # no tuning folder
+    listed = list(rows.values())
+    assert not_tuned_on(listed, "auv-track-v1 v1") == ["sta", "raw"]
+    assert not_tuned_on(listed, "auv-track-v2 v1") == ["pid", "sta", "mine", "raw"]
+    assert not_tuned_on(listed, "auv-track-v1 v2") == ["pid", "sta", "mine", "raw"]  # another version
+
+
 def test_why_it_failed_counts_add_up_and_unknown_causes_show():
     from auvtrack.benchmark.report_competitors import failure_cause_rows
 
@@ -239,8 +266,11 @@ def test_a_v2_like_comparison_end_to_end(tmp_path):
     assert np.all(np.isinf(runs.loc[runs["status"] != "ok", "xtrack_rmse"]))
     assert (runs["cause"][runs["status"] != "ok"] != "").all()  # every failure has a cause
     md = (tmp_path / "out" / "report.md").read_text()
-    for text in ("## Aggregates across tasks", "objective (train / validation)", "xtrack_rmse median"):
+    for text in ("## Aggregates across tasks", "objective (train / validation)", "xtrack_rmse (m) median [95 % bootstrap]",
+                 "failure rate, all runs [Wilson 95 %]"):
         assert text in md, text
+    assert set(doc["not_tuned_on_suite"]) == {"pid", REFERENCE}  # the tiny suite has no preset tuned on it
+    assert "**Not tuned on this suite** (2 of 2)" in md and len(doc["tuning"]) == 2
     assert ("Why it failed" in md) == bool((runs["status"] != "ok").any())
     html = (tmp_path / "out" / "report.html").read_text()
     assert "data:image/png;base64," in html and "<img src=\"figures/" not in html  # self-contained

@@ -20,6 +20,7 @@ from tools import findings
 ALLOWED = [
     r"REMUS 100", r"ERRATA \d+", r"issue \d+", r"§\d+", r"Section \d+", r"Sec\. \d+(\.\d+)?",
     r"Figures? \d+(–\d+)?", r"Theorem \d+", r"Lemma \d+", r"\(\d+\)", r"^#+ \d+\.",
+    r"(auv-track|compare)-v\d+",  # the names of a suite and of its stored result
 ]
 
 
