@@ -23,16 +23,21 @@ from ..engine.loop import (  # the engine's parts this step is built of (rebound
     control_sample, effort_update, eval_reference, finite3, measure, metrics_update, path_update, plant,
     plant_attitude, prange, saturation_update, stage, state_cause, state_free_disturbance, virtual_point,
 )
-from ..metrics import METRICS_SIZE, OFF_E2, OFF_TEN, OFF_TV, metrics_init
+from ..metrics import METRICS_SIZE, OFF_E2, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2, metrics_init
 from ..plant.contract import SCRATCH_SIZE
 
-__all__ = ["Carry", "new_carry", "step_module", "episode_cost", "REWARD", "PARALLEL_FROM"]
+__all__ = ["Carry", "new_carry", "step_module", "episode_cost", "COST_TERMS", "REWARD", "PENALTY", "PARALLEL_FROM"]
 
 PARALLEL_FROM = 256
 """Envs from which a step runs in the thread pool (``step_all``) rather than in one thread (``step_serial``)."""
 
-REWARD = ("k_error", "k_energy", "k_tv", "cap_error", "cap_energy", "cap_tv", "penalty")
+COST_TERMS = ("error", "energy", "tv", "xtrack", "vtrack", "along")
+"""The episode cost's terms (:func:`episode_cost`), in the order of their weights and caps in ``Carry.rw``."""
+N_COST = len(COST_TERMS)
+REWARD = tuple(f"k_{n}" for n in COST_TERMS) + tuple(f"cap_{n}" for n in COST_TERMS) + ("penalty",)
 """Reward terms per env (row of ``Carry.rw``): see :func:`episode_cost`."""
+PENALTY = len(REWARD) - 1
+"""Index of the failure penalty in ``Carry.rw``."""
 
 
 class Carry(NamedTuple):
@@ -82,7 +87,7 @@ def env_step(ins, c, i, bound):
     """One control period of env ``i``: write ``c.obs[i]``, ``c.reward[i]``, ``c.cause[i]``; return the cause.
 
     The reward is minus the increment of :func:`episode_cost` over the period; a failure adds
-    ``-rw[6]``.  ``ks[i]`` = (RK4 step, saturation flags).  At the end of the run (step
+    ``-rw[PENALTY]``.  ``ks[i]`` = (RK4 step, saturation flags).  At the end of the run (step
     ``n_steps``) nothing is integrated and the cause is 0.
     """
     pp, cp, vp, path = ins.pp[i], ins.cp[i], ins.vp[i], ins.path[i]
@@ -164,26 +169,31 @@ def env_step(ins, c, i, bound):
             xc[m] = xcn[m]
         k += 1
     c.ks[i, 0], c.ks[i, 1] = k, sat
-    c.reward[i] = before - episode_cost(rw, acc) - (rw[6] if cause != CAUSE_NONE else 0.0)
+    c.reward[i] = before - episode_cost(rw, acc) - (rw[PENALTY] if cause != CAUSE_NONE else 0.0)
     c.cause[i] = cause
     env_observe(ins, c, i, bound)
     return cause
 
 
 def episode_cost(rw, acc):
-    """The cost of the episode so far: sum over (error, energy, tv) of min(k * S, cap).
+    """The cost of the episode so far: sum over the terms of min(k * S, cap).
 
-    S are the metrics accumulator's sums over the axes: of squared error times dt, of squared
-    tau times dt, and tau's total variation; ``rw`` = (k_error, k_energy, k_tv, cap_error,
-    cap_energy, cap_tv, penalty) (:data:`REWARD`).  Capped, so that a completed episode costs at most
-    the sum of the caps (the failure penalty is more).
+    S are the metrics accumulator's sums (:mod:`auvtrack.metrics`), in the order of
+    :data:`COST_TERMS`: of squared virtual-point error times dt (m^2 s), of squared tau times dt,
+    tau's total variation, and the path-following sums at the navigation point over the window: squared
+    cross-track, vertical-track and along-track error times dt (m^2 s; zero with ``metrics.path = false``).
+    ``rw`` = (k_1 .. k_6, cap_1 .. cap_6, penalty) (:data:`REWARD`).  Capped, so that a completed episode
+    costs at most the sum of the caps (the failure penalty is more).
     """
     s_e, s_n, s_v = 0.0, 0.0, 0.0
     for j in range(3):
         s_e += acc[OFF_E2 + j]
         s_n += acc[OFF_TEN + j]
         s_v += acc[OFF_TV + j]
-    return min(rw[0] * s_e, rw[3]) + min(rw[1] * s_n, rw[4]) + min(rw[2] * s_v, rw[5])
+    n = N_COST
+    return (min(rw[0] * s_e, rw[n]) + min(rw[1] * s_n, rw[n + 1]) + min(rw[2] * s_v, rw[n + 2])
+            + min(rw[3] * acc[OFF_PATH + PATH_XT2], rw[n + 3]) + min(rw[4] * acc[OFF_PATH + PATH_VT2], rw[n + 4])
+            + min(rw[5] * acc[OFF_PATH + PATH_AL2], rw[n + 5]))
 
 
 def env_observe(ins, c, i, bound):
@@ -234,7 +244,8 @@ from numba import prange  # noqa: F401
 from auvtrack.engine.kernels import KernelKey, kernel_module
 from auvtrack.jit import njit  # noqa: F401
 from auvtrack.control.policy_observation import observe  # noqa: F401
-from auvtrack.metrics import OFF_E2, OFF_TEN, OFF_TV  # noqa: F401
+from auvtrack.metrics import OFF_E2, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2  # noqa: F401
+from auvtrack.gym.stepping import N_COST, PENALTY  # noqa: F401
 _k = kernel_module(KernelKey({key.law!r}, {key.plant!r}, {key.label!r}))
 globals().update({{n: getattr(_k, n) for n in dir(_k) if not n.startswith("__")}})
 '''
