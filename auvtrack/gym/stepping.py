@@ -19,9 +19,8 @@ from ..control.contract import WORK_SIZE
 from ..engine import kernels
 from ..control.policy_observation import observe
 from ..engine.loop import (  # the engine's parts this step is built of (rebound in the generated module)
-    CAUSE_CONTROLLER, CAUSE_NONE, SF, SI, STATUS_NONFINITE_INPUT, VP, Buffers, LawOutputs, Loop, attitude,
-    control_sample, effort_update, eval_reference, finite3, measure, metrics_update, path_update, plant,
-    plant_attitude, prange, saturation_update, stage, state_cause, state_free_disturbance, virtual_point,
+    CAUSE_CONTROLLER, CAUSE_NONE, SF, SI, Buffers, LawOutputs, Loop, Settings, advance, attitude, first_stage,
+    Rk4, measure, plant, prange, sample, state_free_disturbance, take_step,
 )
 from ..metrics import METRICS_SIZE, OFF_E2, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2, metrics_init
 from ..plant.contract import SCRATCH_SIZE
@@ -86,26 +85,25 @@ def new_carry(n: int, nxp: int, nxc: int, ncmd: int, nobs: int) -> Carry:
 def env_step(ins, c, i, bound):
     """One control period of env ``i``: write ``c.obs[i]``, ``c.reward[i]``, ``c.cause[i]``; return the cause.
 
-    The reward is minus the increment of :func:`episode_cost` over the period; a failure adds
-    ``-rw[PENALTY]``.  ``ks[i]`` = (RK4 step, saturation flags).  At the end of the run (step
-    ``n_steps``) nothing is integrated and the cause is 0.
+    The engine loop's step (:func:`~auvtrack.engine.loop.run`, sampled-data mode): the same
+    kernel parts (:func:`~auvtrack.engine.loop.sample`, ``first_stage``, ``advance``, ``take_step``)
+    in the same order, from step ``ks[i, 0]`` to the next control sample.  The reward is minus the
+    increment of :func:`episode_cost` over the period; a failure adds ``-rw[PENALTY]``.
+    ``ks[i]`` = (RK4 step, saturation flags).  At the end of the run (step ``n_steps``) nothing is
+    integrated and the cause is 0.
     """
-    pp, cp, vp, path = ins.pp[i], ins.cp[i], ins.vp[i], ins.path[i]
-    si, sf, noise = ins.si[i], ins.sf[i], ins.noise[i]
-    xp, xc, cmd, tau1, kc1, acc = c.xp[i], c.xc[i], c.cmd[i], c.tau1[i], c.kc1[i], c.acc[i]
+    si, sf = ins.si[i], ins.sf[i]
+    xp, xc, acc = c.xp[i], c.xc[i], c.acc[i]
     rw = c.rw[i]
     n_steps, ctrl_every = si[SI.n_steps], si[SI.ctrl_every]
     dt = sf[SF.dt]
     nxp, nxc = xp.shape[0], xc.shape[0]
-    xpn, xcn, xps, xcs = np.empty(nxp), np.empty(nxc), np.empty(nxp), np.empty(nxc)
-    kp1, kp2, kp3, kp4 = np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp)
-    kc2, kc3, kc4 = np.zeros(nxc), np.zeros(nxc), np.zeros(nxc)
-    cmd_sample = np.zeros(cmd.shape[0])
-    buf = Buffers(c.refm[i], c.work[i], c.scr[i], cmd)
-    refm = buf.refm
-    lp = Loop(pp, cp, vp, path, ins.rows[i], ins.current[i], ctrl_every, ctrl_every * dt)
-    tau = np.zeros(3)
-    aux1, aux = np.zeros(1), np.zeros(1)
+    rk = Rk4(np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), c.kc1[i], np.zeros(nxc), np.zeros(nxc),
+             np.zeros(nxc), np.empty(nxp), np.empty(nxc), np.empty(nxp), np.empty(nxc))  # kc1: the held law output
+    cmd_sample = np.zeros(c.cmd.shape[1])
+    buf = Buffers(c.refm[i], c.work[i], c.scr[i], c.cmd[i])
+    lp = Loop(ins.pp[i], ins.cp[i], ins.vp[i], ins.path[i], ins.rows[i], ins.current[i], ctrl_every, ctrl_every * dt)
+    out1, scratch = LawOutputs(c.tau1[i], rk.kc1, np.zeros(1)), LawOutputs(np.zeros(3), rk.kc2, np.zeros(1))
     reuse = state_free_disturbance(ins.rows[i])
     t_late = 0.5 * (sf[SF.win_t0] + min(sf[SF.win_t1], n_steps * dt))
     before = episode_cost(rw, acc)
@@ -116,57 +114,20 @@ def env_step(ins, c, i, bound):
             break
         t = k * dt
         if k % ctrl_every == 0:
-            eval_reference(path, t, refm)
-            eta_t, nu_t = plant.pose(xp)
-            eta, nu = measure(eta_t, nu_t, noise, k // ctrl_every)
-            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf,
-                                    LawOutputs(tau1, kc1, aux1))
-            if status == 0 and not finite3(tau1):
-                status = STATUS_NONFINITE_INPUT
+            status, sat_k = sample(t, k, xp, xc, lp, buf, ins.noise[i], out1, rk, cmd_sample)
             if status != 0:
                 cause = CAUSE_CONTROLLER
                 break
-            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt, cmd_sample)
-            for m in range(cmd_sample.shape[0]):
-                cmd[m] = cmd_sample[m]
-            for m in range(nxc):
-                kc2[m] = kc3[m] = kc4[m] = kc1[m]
-        att = plant_attitude(xp)
-        status, flags = stage(t, xp, xc, att, lp, buf, kp1, LawOutputs(tau1, kc1, aux1), True)
-        applied = plant.applied(xp, cmd, pp)
-        eta, nu = plant.pose(xp)
-        p1 = virtual_point(eta, att, vp[VP.ell])
-        e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
-        metrics_update(acc, t, dt, e, applied, sf[SF.win_t0], sf[SF.win_t1])
-        saturation_update(acc, t, dt, sat, sf[SF.win_t0], sf[SF.win_t1])
-        path_update(acc, t, dt, (eta[0], eta[1], eta[2]), path, sf[SF.win_t0], sf[SF.win_t1], t_late)
-        effort_update(acc, t, dt, plant.effort(xp, cmd, pp), sf[SF.win_t0], sf[SF.win_t1])
-        for m in range(nxp):
-            xps[m] = xp[m] + 0.5 * dt * kp1[m]
-        for m in range(nxc):
-            xcs[m] = xc[m] + 0.5 * dt * kc1[m]
-        stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, LawOutputs(tau, kc2, aux), True)
-        for m in range(nxp):
-            xps[m] = xp[m] + 0.5 * dt * kp2[m]
-        for m in range(nxc):
-            xcs[m] = xc[m] + 0.5 * dt * kc2[m]
-        stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, LawOutputs(tau, kc3, aux), not reuse)
-        for m in range(nxp):
-            xps[m] = xp[m] + dt * kp3[m]
-        for m in range(nxc):
-            xcs[m] = xc[m] + dt * kc3[m]
-        stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, LawOutputs(tau, kc4, aux), True)
-        for m in range(nxp):
-            xpn[m] = xp[m] + dt / 6.0 * (kp1[m] + 2.0 * kp2[m] + 2.0 * kp3[m] + kp4[m])
-        for m in range(nxc):
-            xcn[m] = xc[m] + dt / 6.0 * (kc1[m] + 2.0 * kc2[m] + 2.0 * kc3[m] + kc4[m])
-        cause = state_cause(xpn, xcn, sf)
+            sat = sat_k
+        status, _, applied, eta, e = first_stage(t, xp, xc, lp, buf, rk, out1)
+        if status == 0:
+            status, cause = advance(t, dt, xp, xc, lp, buf, rk, e, applied, eta, sat, acc, Settings(si, sf), t_late,
+                                    reuse, scratch)
+        if status != 0:
+            cause = CAUSE_CONTROLLER
         if cause != CAUSE_NONE:
             break
-        for m in range(nxp):
-            xp[m] = xpn[m]
-        for m in range(nxc):
-            xc[m] = xcn[m]
+        take_step(xp, xc, rk)
         k += 1
     c.ks[i, 0], c.ks[i, 1] = k, sat
     c.reward[i] = before - episode_cost(rw, acc) - (rw[PENALTY] if cause != CAUSE_NONE else 0.0)
