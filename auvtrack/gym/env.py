@@ -31,7 +31,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from ..benchmark.suite import ControllerEntry, Suite, load_suite
+from ..benchmark.suite import Suite, load_suite
 from ..control.policy_observation import OBS, OBS_BOUND
 from ..engine.loop import CAUSES, SI, Stacked
 from ..metrics import metrics_finalize
