@@ -30,11 +30,17 @@ QUICK_ITERATIONS, ITERATIONS = 8, 50
 @click.option("--duration", type=float, default=None, help="Episode length in s (default: the task's).")
 @click.option("--quick", is_flag=True, help="The suite's quick episodes and a small budget (a CI-sized run).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the directions and seed draws.")
+@click.option("--method", default="ars", show_default=True, metavar="ars|cmaes",
+              help="ars: augmented random search V2-t; cmaes: CMA-ES (the cma library), lambda = 2 x --directions, "
+                   "initial step size --noise.")
+@click.option("--action", default="tau", show_default=True, metavar="tau|actuators",
+              help="What the policy commands: normalised tau, or a 6-DOF tier's actuators (rpm, fins).")
 @click.option("--quiet", is_flag=True, help="No progress line.")
 def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, iterations: int | None,
           directions: int, top: int, step_size: float, noise: float, seeds_per_iteration: int, eval_every: int,
-          substeps: int, duration: float | None, quick: bool, seed: int, quiet: bool) -> None:
-    """Train a policy for a suite's tier by augmented random search (no deep-learning stack); Ctrl-C keeps
+          substeps: int, duration: float | None, quick: bool, seed: int, method: str, action: str,
+          quiet: bool) -> None:
+    """Train a policy for a suite's tier by augmented random search or CMA-ES (no deep-learning stack); Ctrl-C keeps
     every completed iteration, run again to resume.
     """
     from ..benchmark.suite import SuiteError
@@ -45,7 +51,7 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
                       iterations=iterations if iterations is not None else (QUICK_ITERATIONS if quick else ITERATIONS),
                       directions=directions, top=top, step_size=step_size, noise=noise,
                       seeds_per_iteration=seeds_per_iteration, eval_every=eval_every, substeps=substeps,
-                      duration=duration, quick=quick, seed=seed)
+                      duration=duration, quick=quick, seed=seed, method=method, action=action)
 
     def progress(row: dict) -> None:
         if not quiet:

@@ -46,8 +46,9 @@ def test_running_statistics_equal_the_batch_statistics(sizes, seed):
         np.testing.assert_allclose(s.std(), allx.std(axis=0, ddof=1), rtol=1e-9)
 
 
-def test_killed_and_resumed_equals_uninterrupted(tmp_path, suite_file):
-    cfg = _cfg(suite_file)
+@pytest.mark.parametrize("method", ["ars", "cmaes"])
+def test_killed_and_resumed_equals_uninterrupted(tmp_path, suite_file, method):
+    cfg = _cfg(suite_file, method=method)
     whole = train(cfg, tmp_path / "whole")
 
     def kill(row):
@@ -105,7 +106,22 @@ def test_quick_improves_the_held_out_return(tmp_path, suite_file, capsys):
     assert "held-out return: initial policy" in capsys.readouterr().out
 
 
+def test_cmaes_quick_improves_the_held_out_return(tmp_path, suite_file):
+    """CI-sized CMA-ES: tiny suite (calm tier, both tasks, 1 s quick episodes), seed 0, 8 iterations, lambda = 8."""
+    out = tmp_path / "cma"
+    code = main(["train", "--quick", "--method", "cmaes", "--suite", str(suite_file), "--tier", "calm",
+                 "--directions", "4", "--noise", "0.05", "--seeds-per-iteration", "1", "--eval-every", "4",
+                 "--seed", "0", "--out", str(out), "--quiet"])
+    assert code == 0
+    curve = json.loads(str(np.load(out / "checkpoint.npz")["curve"]))
+    first, last = curve[0]["validation_return"], curve[-1]["validation_return"]
+    assert last > first, (first, last)
+    prov = load_policy(out / "policy.npz")["header"]["provenance"]
+    assert "CMA-ES" in prov["method"] and "--method cmaes" in prov["command"]
+
+
 @pytest.mark.parametrize("args, field", [(["--top", "9"], "--top"), (["--noise", "0"], "--noise"),
+                                        (["--method", "sgd"], "--method"), (["--action", "fins"], "--action"),
                                         (["--tier", "nope"], "tier"), (["--task", "nope"], "tasks")])
 def test_bad_settings_one_line(tmp_path, suite_file, capsys, args, field):
     code = main(["train", "--suite", str(suite_file), "--out", str(tmp_path / "o"), *args])
