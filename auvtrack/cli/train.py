@@ -35,11 +35,14 @@ QUICK_ITERATIONS, ITERATIONS = 8, 50
                    "initial step size --noise.")
 @click.option("--action", default="tau", show_default=True, metavar="tau|actuators",
               help="What the policy commands: normalised tau, or a 6-DOF tier's actuators (rpm, fins).")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Run the training rollouts on an existing Dask scheduler, tcp://host:port (probed first); "
+                   "the workers must read the suite file. The numbers are those of a local training.")
 @click.option("--quiet", is_flag=True, help="No progress line.")
 def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, iterations: int | None,
           directions: int, top: int, step_size: float, noise: float, seeds_per_iteration: int, eval_every: int,
           substeps: int, duration: float | None, quick: bool, seed: int, method: str, action: str,
-          quiet: bool) -> None:
+          scheduler: str | None, quiet: bool) -> None:
     """Train a policy for a suite's tier by augmented random search or CMA-ES (no deep-learning stack); Ctrl-C keeps
     every completed iteration, run again to resume.
     """
@@ -65,15 +68,26 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
     except ValueError as exc:  # the field named as its option
         field, _, rest = str(exc).partition(":")
         raise BadInput(f"--{field.replace('_', '-')}:{rest}") from None
+    client = None
+    if scheduler:
+        from ..batch.scheduler import SchedulerError, connect_scheduler
+
+        try:
+            client = connect_scheduler(scheduler)
+        except SchedulerError as exc:
+            raise BadInput(str(exc)) from None
     with stop_once():
         try:
-            res = _train(cfg, out, progress=progress)
+            res = _train(cfg, out, progress=progress, client=client)
         except (SuiteError, ValueError) as exc:
             raise BadInput(one_line(exc)) from None
         except KeyboardInterrupt:
             click.echo(f"auvtrack: interrupted; {out} holds every completed iteration (policy.npz, checkpoint.npz); "
                        "the same command resumes", err=True)
             raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
+        finally:
+            if client is not None:
+                client.close()
     first, last = res.curve[0]["validation_return"], res.curve[-1]["validation_return"]
     click.echo(f"iterations: {len(res.curve) - 1}; episodes: {res.episodes}; env steps: {res.env_steps}; "
                f"wall {res.wall_s:.1f} s")

@@ -168,6 +168,53 @@ class TrainResult:
     outputs: dict[str, Path] = field(default_factory=dict)
 
 
+def _moments(batch: np.ndarray) -> tuple[int, np.ndarray | None, np.ndarray | None]:
+    """(rows, mean, sum of squared deviations) of a batch of observations (None, None when empty)."""
+    nb = batch.shape[0]
+    if nb == 0:
+        return 0, None, None
+    mb = batch.mean(axis=0)
+    return nb, mb, ((batch - mb) ** 2).sum(axis=0)
+
+
+class _Moments(list):
+    """The :func:`_moments` of every batch a rollout adds, in order (merged later into a :class:`_Stats`)."""
+
+    def add(self, batch: np.ndarray) -> None:
+        self.append(_moments(batch))
+
+
+_REMOTE_ENVS: dict[tuple, TrackVectorEnv] = {}
+"""Vector environments a Dask worker keeps between iterations, per (suite, quick, task, tier, n, settings)."""
+
+
+def remote_rollout(key: tuple, seeds, Ms: np.ndarray, mean: np.ndarray, std: np.ndarray):
+    """:func:`rollout` on a Dask worker: the env of ``key`` (made once per worker), the batches' moments recorded.
+
+    Parameters
+    ----------
+    key : tuple
+        (suite name or file, quick, task, tier, num_envs, action, substeps, duration).
+    seeds, Ms, mean, std
+        As :func:`rollout`.
+
+    Returns
+    -------
+    (numpy.ndarray, int, list)
+        Returns, environment steps, and the moments of the observation batches in order.
+    """
+    venv = _REMOTE_ENVS.get(key)
+    if venv is None:
+        suite, quick, task, tier, n, action, substeps, duration = key
+        s = suite_of(suite)
+        venv = TrackVectorEnv(n, s.quick_variant() if quick else s, task, tier, action=action, substeps=substeps,
+                              duration=duration, autoreset="disabled")
+        _REMOTE_ENVS[key] = venv
+    moments = _Moments()
+    r, steps = rollout(venv, seeds, Ms, mean, std, moments)
+    return r, steps, list(moments)
+
+
 class _Stats:
     """Running mean and sum of squared deviations of the observations (Chan et al. 1979, pairwise update)."""
 
@@ -177,11 +224,13 @@ class _Stats:
         self.m2 = np.zeros(OBS.size) if m2 is None else np.asarray(m2, float).copy()
 
     def add(self, batch: np.ndarray) -> None:
-        nb = batch.shape[0]
+        """Add a batch of observations (rows)."""
+        self.merge(*_moments(batch))
+
+    def merge(self, nb: int, mb: np.ndarray | None, m2b: np.ndarray | None) -> None:
+        """Add a batch given by its size, mean and sum of squared deviations (:func:`_moments`)."""
         if nb == 0:
             return
-        mb = batch.mean(axis=0)
-        m2b = ((batch - mb) ** 2).sum(axis=0)
         n = self.n + nb
         delta = mb - self.mean
         self.mean = self.mean + delta * (nb / n)
@@ -281,6 +330,7 @@ class _Trainer:
         self.val_envs = {t: TrackVectorEnv(len(self.val_seeds), self.suite, t, self.tier, action=cfg.action,
                                            substeps=cfg.substeps, duration=dur[t], autoreset="disabled")
                          for t in self.tasks}
+        self.client = None  # a Dask client: the training rollouts run on its workers
         self.es = None  # CMA-ES: the strategy (made by start_cmaes)
         self.fitness: list[np.ndarray] = []  # CMA-ES: the values told per iteration (checkpointed)
         first = self.train_envs[self.tasks[0]].one
@@ -312,11 +362,28 @@ class _Trainer:
         Ms = np.repeat(Ms, cfg.seeds_per_iteration, axis=0)  # env order: (policy, seed)
         env_seeds = np.tile(seeds, n)
         total, steps = np.zeros(n), 0
-        for venv in self.train_envs.values():
-            r, k = rollout(venv, env_seeds, Ms, mean, std, stats)
+        if self.client is not None:  # one task per training task, merged in task order: the local numbers
+            futures = [self.client.submit(remote_rollout, self.remote_key(t), env_seeds, Ms, mean, std, pure=False)
+                       for t in self.train_envs]
+            done = self.client.gather(futures)
+        else:
+            done = None
+        for i, venv in enumerate(self.train_envs.values()):
+            if done is None:
+                r, k = rollout(venv, env_seeds, Ms, mean, std, stats)
+            else:
+                r, k, moments = done[i]
+                for m in moments:
+                    stats.merge(*m)
             total += r.reshape(n, cfg.seeds_per_iteration).mean(axis=1)
             steps += k
         return total / len(self.train_envs), steps
+
+    def remote_key(self, task: str) -> tuple:
+        """The :func:`remote_rollout` key of a training task's environments."""
+        venv = self.train_envs[task]
+        return (self.cfg.suite, self.cfg.quick, task, self.tier, venv.num_envs, self.cfg.action, self.cfg.substeps,
+                venv.one.duration)
 
     def iteration(self, j: int, M: np.ndarray, stats: _Stats) -> tuple[np.ndarray, float, int, int]:
         """Iteration ``j`` from M (stats updated in place): new M, mean training return, episodes, steps."""
@@ -470,7 +537,8 @@ def command_line(cfg: TrainConfig) -> str:
     return " ".join(shlex.quote(a) for a in args)
 
 
-def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None] | None = None) -> TrainResult:
+def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None] | None = None,
+          client=None) -> TrainResult:
     """Train (or resume training) a linear policy; write the policy file, the curve and a checkpoint.
 
     Parameters
@@ -483,6 +551,10 @@ def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None]
     progress : callable, optional
         Called with each curve row as its iteration completes (it may raise to stop: the
         checkpoint holds every completed iteration).
+    client : distributed.Client, optional
+        Run each iteration's training rollouts on its workers (one task per training task; each
+        worker keeps its environments); the numbers are those of a local training.  The held-out
+        evaluations run here.  The caller closes the client.
 
     Returns
     -------
@@ -492,6 +564,7 @@ def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None]
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     trainer = _Trainer(cfg)
+    trainer.client = client
     ckpt = out / CHECKPOINT
     if ckpt.is_file():
         j, M, stats, res, fitness = _load_checkpoint(ckpt, cfg)

@@ -134,3 +134,40 @@ def test_suite_without_splits_refused(tmp_path, capsys):
     path.write_text(TINY)
     assert main(["train", "--suite", str(path), "--out", str(tmp_path / "o")]) == 2
     assert "splits.training" in capsys.readouterr().err
+
+
+@pytest.fixture
+def dask_client():
+    """A local Dask cluster (two worker threads), always closed."""
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        yield client
+
+
+@pytest.mark.parametrize("method", ["ars", "cmaes"])
+def test_rollouts_on_dask_equal_the_local_training(tmp_path, suite_file, dask_client, method):
+    """Both training tasks' rollouts on the cluster: the same policy, statistics and curve bit for bit."""
+    cfg = _cfg(suite_file, method=method, tasks=("line", "helix"))
+    local = train(cfg, tmp_path / "local")
+    remote = train(cfg, tmp_path / "dask", client=dask_client)
+    assert np.any(local.M != 0)
+    assert np.array_equal(remote.M, local.M) and np.array_equal(remote.mean, local.mean)
+    assert np.array_equal(remote.std, local.std)
+    drop = lambda curve: [{k: v for k, v in r.items() if k != "wall_s"} for r in curve]
+    assert drop(remote.curve) == drop(local.curve)
+    assert train_mod._REMOTE_ENVS  # the worker threads of this process kept their environments
+
+
+def test_scheduler_nobody_answers_is_one_line(tmp_path, suite_file, capsys):
+    import socket
+
+    sock = socket.socket()
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    sock.close()  # a closed port
+    code = main(["train", "--suite", str(suite_file), "--out", str(tmp_path / "o"), "--scheduler",
+                 f"tcp://127.0.0.1:{port}"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "--scheduler" in err, err
