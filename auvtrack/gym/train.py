@@ -42,7 +42,8 @@ from .._atomic import atomic_file, atomic_write
 from ..benchmark.suite import Suite
 from ..control.policy import save_policy
 from ..control.policy_observation import OBS
-from .env import suite_of
+from .env import reward_weights, suite_of
+from .stepping import COST_TERMS
 from .vector import TrackVectorEnv
 
 __all__ = ["METHOD", "METHODS", "TrainConfig", "TrainResult", "command_line", "rollout", "train"]
@@ -284,6 +285,12 @@ def rollout(venv: TrackVectorEnv, seeds, Ms: np.ndarray, mean: np.ndarray, std: 
     return ret, steps
 
 
+def _reward_terms(suite: Suite) -> dict:
+    """The reward's cost terms with a weight (:func:`auvtrack.gym.env.reward_weights`): term -> (k, cap)."""
+    k, caps, _ = reward_weights(suite)
+    return {t: [kt, ct] for t, kt, ct in zip(COST_TERMS, k, caps) if kt > 0}
+
+
 def _provenance(cfg: TrainConfig, suite: Suite, tier: str, tasks, res: TrainResult) -> dict:
     import gymnasium
 
@@ -296,7 +303,7 @@ def _provenance(cfg: TrainConfig, suite: Suite, tier: str, tasks, res: TrainResu
             "config": asdict(cfg), "budget": {"iterations": len(res.curve) - 1, "episodes": res.episodes,
                                               "env_steps": res.env_steps, "rk4_steps": res.env_steps * cfg.substeps,
                                               "wall_s": round(res.wall_s, 1)},
-            "validation_return": last, "command": command_line(cfg),
+            "validation_return": last, "command": command_line(cfg), "reward": _reward_terms(suite),
             "versions": {"auvtrack": __version__, "numpy": np.__version__, "gymnasium": gymnasium.__version__,
                          "python": platform.python_version()}}
 
