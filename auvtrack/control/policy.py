@@ -33,7 +33,7 @@ ACTIVATIONS = ("identity", "tanh", "relu")
 FORMAT = "auvtrack-policy"
 HEAD = packed_layout("PolicyHead", n_layers=1, rest=None)
 SHIPPED = Path(__file__).resolve().parents[1] / "data" / "policies"
-DEFAULT_POLICY = "remus100-ars"
+DEFAULT_POLICY = "remus100-cmaes"
 """The shipped policy ``controller.kind = "policy"`` flies without a ``file``."""
 DEFAULT_ACTUATOR_POLICY = "policy.npz"
 """What ``controller.kind = "policy_actuators"`` flies without a ``file`` (no actuator policy is shipped)."""
