@@ -162,3 +162,20 @@ def test_return_charges_the_path_metrics_of_the_run_score():
     energy = sum(v for k, v in m.items() if k.startswith("energy_tau_"))
     cost = 0.25 * min(ms2, 9.0) + 0.1 * min(energy / 500.0, 3.0) + sum(path.values())
     assert ret == pytest.approx(-cost, rel=1e-9)
+
+
+def _v2_cells():
+    from auvtrack.gym.env import suite_of
+
+    suite = suite_of("auv-track-v2")
+    six = {t for t in suite.tiers if suite.file.tiers[t].requires_plant == "6dof"}
+    return [(task, tier, action) for task in suite.tasks for tier in suite.tiers
+            for action in (("tau", "actuators") if tier in six else ("tau",))]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("task, tier, action", _v2_cells())
+def test_check_env_every_cell_and_action_mode_of_auv_track_v2(task, tier, action):
+    """The checker on every task x tier of the shipped v2 suite, both action modes on the 6-DOF tiers (0.2 s episodes)."""
+    env = TrackEnv("auv-track-v2", task, tier, action=action, duration=0.2)
+    check_env(env, skip_render_check=True)
