@@ -30,11 +30,20 @@ QUICK_ITERATIONS, ITERATIONS = 8, 50
 @click.option("--duration", type=float, default=None, help="Episode length in s (default: the task's).")
 @click.option("--quick", is_flag=True, help="The suite's quick episodes and a small budget (a CI-sized run).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the directions and seed draws.")
+@click.option("--method", default="ars", show_default=True, metavar="ars|cmaes",
+              help="ars: augmented random search V2-t; cmaes: CMA-ES (the cma library), lambda = 2 x --directions, "
+                   "initial step size --noise.")
+@click.option("--action", default="tau", show_default=True, metavar="tau|actuators",
+              help="What the policy commands: normalised tau, or a 6-DOF tier's actuators (rpm, fins).")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Run the training rollouts on an existing Dask scheduler, tcp://host:port (probed first); "
+                   "the workers must read the suite file. The numbers are those of a local training.")
 @click.option("--quiet", is_flag=True, help="No progress line.")
 def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, iterations: int | None,
           directions: int, top: int, step_size: float, noise: float, seeds_per_iteration: int, eval_every: int,
-          substeps: int, duration: float | None, quick: bool, seed: int, quiet: bool) -> None:
-    """Train a policy for a suite's tier by augmented random search (no deep-learning stack); Ctrl-C keeps
+          substeps: int, duration: float | None, quick: bool, seed: int, method: str, action: str,
+          scheduler: str | None, quiet: bool) -> None:
+    """Train a policy for a suite's tier by augmented random search or CMA-ES (no deep-learning stack); Ctrl-C keeps
     every completed iteration, run again to resume.
     """
     from ..benchmark.suite import SuiteError
@@ -45,7 +54,7 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
                       iterations=iterations if iterations is not None else (QUICK_ITERATIONS if quick else ITERATIONS),
                       directions=directions, top=top, step_size=step_size, noise=noise,
                       seeds_per_iteration=seeds_per_iteration, eval_every=eval_every, substeps=substeps,
-                      duration=duration, quick=quick, seed=seed)
+                      duration=duration, quick=quick, seed=seed, method=method, action=action)
 
     def progress(row: dict) -> None:
         if not quiet:
@@ -59,15 +68,26 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
     except ValueError as exc:  # the field named as its option
         field, _, rest = str(exc).partition(":")
         raise BadInput(f"--{field.replace('_', '-')}:{rest}") from None
+    client = None
+    if scheduler:
+        from ..batch.scheduler import SchedulerError, connect_scheduler
+
+        try:
+            client = connect_scheduler(scheduler)
+        except SchedulerError as exc:
+            raise BadInput(str(exc)) from None
     with stop_once():
         try:
-            res = _train(cfg, out, progress=progress)
+            res = _train(cfg, out, progress=progress, client=client)
         except (SuiteError, ValueError) as exc:
             raise BadInput(one_line(exc)) from None
         except KeyboardInterrupt:
             click.echo(f"auvtrack: interrupted; {out} holds every completed iteration (policy.npz, checkpoint.npz); "
                        "the same command resumes", err=True)
             raise click.exceptions.Exit(EXIT_INTERRUPTED) from None
+        finally:
+            if client is not None:
+                client.close()
     first, last = res.curve[0]["validation_return"], res.curve[-1]["validation_return"]
     click.echo(f"iterations: {len(res.curve) - 1}; episodes: {res.episodes}; env steps: {res.env_steps}; "
                f"wall {res.wall_s:.1f} s")

@@ -2,7 +2,7 @@
 
 Registering a built-in controller is one line: its module in :data:`BUILTIN` (checked against
 :mod:`auvtrack.control.contract`).  ``policy`` (a learned law flying a trained file,
-:mod:`auvtrack.control.policy`) and ``plugin`` are registered after them: the first enters a
+:mod:`auvtrack.control.policy`; ``policy_actuators`` for a file commanding a 6-DOF plant's actuators) and ``plugin`` are registered after them: the first enters a
 comparison when named, the second is the loader of controllers from outside the package (kind ``"plugin"``).
 """
 from importlib import import_module
@@ -28,6 +28,7 @@ BUILTIN_NAMES: tuple[str, ...] = tuple(m.NAME for m in BUILTIN)
 for _module in BUILTIN:
     register(_module)
 register(import_module(f"{__name__}.policy"))  # a learned law flying a trained file: not among the default competitors
+register(import_module(f"{__name__}.policy_actuators"))  # the same, commanding a 6-DOF plant's actuators
 register(ControllerSpec(plugin.NAME, plugin.__name__, plugin.Params, plugin.setup,
                         "a controller module from outside the package (controller.module)"))
 

@@ -33,8 +33,12 @@ ACTIVATIONS = ("identity", "tanh", "relu")
 FORMAT = "auvtrack-policy"
 HEAD = packed_layout("PolicyHead", n_layers=1, rest=None)
 SHIPPED = Path(__file__).resolve().parents[1] / "data" / "policies"
-DEFAULT_POLICY = "remus100-ars"
+DEFAULT_POLICY = "remus100-cmaes"
 """The shipped policy ``controller.kind = "policy"`` flies without a ``file``."""
+DEFAULT_ACTUATOR_POLICY = "policy.npz"
+"""What ``controller.kind = "policy_actuators"`` flies without a ``file`` (no actuator policy is shipped)."""
+COMMAND_KINDS = ("tau", "actuators")
+"""What a policy file's outputs command: tau (N, N m, N m) or the actuators (rpm, rad, rad)."""
 
 
 def available_policies() -> list[str]:
@@ -76,7 +80,7 @@ class Params(ControllerParams):
 
 
 def save_policy(path: str | Path, weights, biases, activations, scale, obs_mean=None, obs_std=None,
-                provenance: dict | None = None) -> Path:
+                provenance: dict | None = None, commands: str = "tau") -> Path:
     """Write a policy file.
 
     Parameters
@@ -94,6 +98,9 @@ def save_policy(path: str | Path, weights, biases, activations, scale, obs_mean=
         Observation normalisation (default 0 and 1).
     provenance : dict, optional
         How it was made (command, budget, seed).
+    commands : str, optional
+        ``"tau"`` (default; ``controller.kind = "policy"``) or ``"actuators"`` (the outputs are
+        (rpm, stern plane, rudder) of a 6-DOF plant; ``controller.kind = "policy_actuators"``).
 
     Returns
     -------
@@ -102,7 +109,9 @@ def save_policy(path: str | Path, weights, biases, activations, scale, obs_mean=
     """
     weights = [np.asarray(w, float) for w in weights]
     biases = [np.asarray(b, float) for b in biases]
-    header = {"format": FORMAT, "version": 1, "commands": "tau", "scale": [float(s) for s in scale],
+    if commands not in COMMAND_KINDS:
+        raise ValueError(f"commands: must be one of {', '.join(COMMAND_KINDS)} (got {commands!r})")
+    header = {"format": FORMAT, "version": 1, "commands": commands, "scale": [float(s) for s in scale],
               "activations": list(activations), "provenance": provenance or {}}
     arrays = {f"W{i}": w for i, w in enumerate(weights)} | {f"b{i}": b for i, b in enumerate(biases)}
     arrays["obs_mean"] = np.zeros(OBS.size) if obs_mean is None else np.asarray(obs_mean, float)
@@ -163,6 +172,8 @@ def load_policy(path: str | Path) -> dict[str, Any]:
     std = np.asarray(data["obs_std"], float)
     if std.shape != (OBS.size,) or not np.all(std > 0) or np.asarray(data["obs_mean"]).shape != (OBS.size,):
         raise ValueError(f"controller.file: {path}: obs_mean, obs_std must have {OBS.size} entries, std > 0")
+    if header.get("commands", "tau") not in COMMAND_KINDS:
+        raise ValueError(f"controller.file: {path}: commands must be one of {', '.join(COMMAND_KINDS)}")
     every = [*weights, *biases, data["obs_mean"], std, np.asarray(header.get("scale", []), float)]
     if not all(np.all(np.isfinite(a)) for a in every) or len(header.get("scale", [])) != 3:
         raise ValueError(f"controller.file: {path}: non-finite numbers or a scale without 3 entries")
@@ -252,8 +263,10 @@ def control(t, y, xc, args, out):
 def setup(params: Params, ctx) -> CompiledController:
     """Load the policy file and pack it."""
     policy = load_policy(params.file)
-    if policy["header"].get("commands", "tau") != ctx.commands:
-        raise ValueError(f"controller.file: the policy commands {policy['header'].get('commands')!r}, "
-                         f"the plant takes {ctx.commands!r}")
+    commands = policy["header"].get("commands", "tau")
+    if commands != ctx.commands:
+        kind = "policy_actuators" if commands == "actuators" else "policy"
+        raise ValueError(f"controller.file: the policy commands {commands!r}, the law {ctx.commands!r} "
+                         f"(controller.kind = {kind!r} flies it)")
     return CompiledController(cp=pack(policy), xc0=np.zeros(0),
                               resolved={"policy": {"file": str(policy_path(params.file)), **policy["header"]}})

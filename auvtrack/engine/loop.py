@@ -145,6 +145,27 @@ class Buffers(NamedTuple):
     cmd: np.ndarray
 
 
+class Rk4(NamedTuple):
+    """Arrays of one RK4 step: stage derivatives, stage states and the state after the step.
+
+    ``kp1`` .. ``kp4`` (plant) and ``kc1`` .. ``kc4`` (controller) are the stage derivatives,
+    ``xps``, ``xcs`` the stage states, ``xpn``, ``xcn`` the states after the step.
+    """
+
+    kp1: np.ndarray
+    kp2: np.ndarray
+    kp3: np.ndarray
+    kp4: np.ndarray
+    kc1: np.ndarray
+    kc2: np.ndarray
+    kc3: np.ndarray
+    kc4: np.ndarray
+    xps: np.ndarray
+    xcs: np.ndarray
+    xpn: np.ndarray
+    xcn: np.ndarray
+
+
 class Stacked(NamedTuple):
     """The inputs of many runs with equal array shapes: row ``i`` of each is run ``i``'s array."""
 
@@ -330,6 +351,106 @@ def control_sample(t, eta, nu, att, xc, xp, lp, buf, out):
     return law_call(t, eta, nu, att, xc, xp, lp, buf, out)
 
 
+@kernel_part("njit_noalloc(inline='always')")
+def sample(t, k, xp, xc, lp, buf, noise, out, rk, cmd_sample):
+    """One control sample (sampled-data mode): measure, the law, the allocation; hold the command and ``out.dxc``.
+
+    The law sees the plant's pose plus row ``k // ctrl_every`` of ``noise``; the new command is
+    written to ``buf.cmd`` and the law's state derivative to ``rk.kc2`` .. ``rk.kc4`` (held for every
+    stage until the next sample; ``out.dxc`` is stage 1's).  Returns (status, saturation flags of the
+    command): status 0, the law's failure status, or :data:`STATUS_NONFINITE_INPUT`.
+    """
+    eval_reference(lp.path, t, buf.refm)
+    eta_t, nu_t = plant.pose(xp)
+    eta, nu = measure(eta_t, nu_t, noise, k // lp.ctrl_every)
+    u = out.u
+    status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf, out)
+    if status == 0 and not finite3(u):
+        status = STATUS_NONFINITE_INPUT
+    if status != 0:
+        return status, 0
+    sat = plant.allocate((u[0], u[1], u[2]), eta, nu, xp, lp.pp, buf.cmd, lp.h, cmd_sample)
+    cmd = buf.cmd
+    for i in range(cmd_sample.shape[0]):
+        cmd[i] = cmd_sample[i]
+    kc1, kc2, kc3, kc4 = out.dxc, rk.kc2, rk.kc3, rk.kc4
+    for i in range(xc.shape[0]):
+        kc2[i] = kc3[i] = kc4[i] = kc1[i]
+    return 0, sat
+
+
+@kernel_part("njit_noalloc(inline='always')")
+def first_stage(t, xp, xc, lp, buf, rk, out):
+    """RK4 stage 1 at (t, x) into ``rk.kp1`` and ``out``; return (status, flags, applied input, eta, e).
+
+    The applied input (what the plant produces), the true pose and the virtual point's error to
+    the reference are the values that are logged and enter the metrics.
+    """
+    att = plant_attitude(xp)
+    status, flags = stage(t, xp, xc, att, lp, buf, rk.kp1, out, True)
+    applied = plant.applied(xp, buf.cmd, lp.pp)
+    eta, nu = plant.pose(xp)
+    refm = buf.refm
+    p1 = virtual_point(eta, att, lp.vp[VP.ell])
+    e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
+    return status, flags, applied, eta, e
+
+
+@kernel_part("njit_noalloc(inline='always')")
+def advance(t, dt, xp, xc, lp, buf, rk, e, applied, eta, sat, acc, settings, t_late, reuse, outs):
+    """The step's metrics at (t, x), then RK4 stages 2 to 4 and the state after the step in ``rk.xpn``, ``rk.xcn``.
+
+    Stage 1 is in ``rk.kp1``, ``rk.kc1`` (:func:`first_stage`); ``outs`` are the law-output bundles
+    of stages 2, 3 and 4 (on ``rk.kc2``, ``rk.kc3``, ``rk.kc4``), built once by the caller.  The path-following metrics are added when ``settings.si[SI.path_metrics]`` is set;
+    ``t_late`` starts their second half.  Returns (controller status of the stages, failure cause
+    of the state after the step): the caller takes the step (:func:`take_step`) when both are 0.
+    """
+    si, sf = settings.si, settings.sf
+    t0, t1 = sf[SF.win_t0], sf[SF.win_t1]
+    metrics_update(acc, t, dt, e, applied, t0, t1)
+    saturation_update(acc, t, dt, sat, t0, t1)
+    if si[SI.path_metrics] != 0:
+        path_update(acc, t, dt, (eta[0], eta[1], eta[2]), lp.path, t0, t1, t_late)
+    effort_update(acc, t, dt, plant.effort(xp, buf.cmd, lp.pp), t0, t1)
+    kp1, kp2, kp3, kp4, kc1, kc2, kc3, kc4 = rk.kp1, rk.kp2, rk.kp3, rk.kp4, rk.kc1, rk.kc2, rk.kc3, rk.kc4
+    xps, xcs, xpn, xcn = rk.xps, rk.xcs, rk.xpn, rk.xcn
+    nxp, nxc = xp.shape[0], xc.shape[0]
+    for i in range(nxp):
+        xps[i] = xp[i] + 0.5 * dt * kp1[i]
+    for i in range(nxc):
+        xcs[i] = xc[i] + 0.5 * dt * kc1[i]
+    status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, outs[0], True)
+    if status == 0:
+        for i in range(nxp):
+            xps[i] = xp[i] + 0.5 * dt * kp2[i]
+        for i in range(nxc):
+            xcs[i] = xc[i] + 0.5 * dt * kc2[i]
+        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, outs[1], not reuse)
+    if status == 0:
+        for i in range(nxp):
+            xps[i] = xp[i] + dt * kp3[i]
+        for i in range(nxc):
+            xcs[i] = xc[i] + dt * kc3[i]
+        status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, outs[2], True)
+    if status != 0:
+        return status, CAUSE_NONE
+    for i in range(nxp):
+        xpn[i] = xp[i] + dt / 6.0 * (kp1[i] + 2.0 * kp2[i] + 2.0 * kp3[i] + kp4[i])
+    for i in range(nxc):
+        xcn[i] = xc[i] + dt / 6.0 * (kc1[i] + 2.0 * kc2[i] + 2.0 * kc3[i] + kc4[i])
+    return 0, state_cause(xpn, xcn, sf)
+
+
+@kernel_part("njit_noalloc(inline='always')")
+def take_step(xp, xc, rk):
+    """Take the step :func:`advance` computed: x = (``rk.xpn``, ``rk.xcn``)."""
+    xpn, xcn = rk.xpn, rk.xcn
+    for i in range(xp.shape[0]):
+        xp[i] = xpn[i]
+    for i in range(xc.shape[0]):
+        xc[i] = xcn[i]
+
+
 @kernel_part("njit")
 def log_row(log, row, t, xp, cmd, pp, tau, refm, e, aux, naux, dxp, vp):
     """Fill one logged row (:data:`~auvtrack.channels.LOG_ROW`); chi uses the nominal model with the produced input."""
@@ -367,10 +488,9 @@ def run(pb, cb, env, ref_p, settings, out):
     naux = si[SI.n_aux]
     dt = sf[SF.dt]
     xp, xc = pb.x0.copy(), cb.x0.copy()
-    xpn, xcn = np.empty(nxp), np.empty(nxc)  # the state after a step, checked before it is taken
-    xps, xcs = np.empty(nxp), np.empty(nxc)
-    kp1, kp2, kp3, kp4 = np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp)
-    kc1, kc2, kc3, kc4 = np.zeros(nxc), np.zeros(nxc), np.zeros(nxc), np.zeros(nxc)
+    # the state after a step (rk.xpn, rk.xcn) is checked before it is taken
+    rk = Rk4(np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxc), np.zeros(nxc), np.zeros(nxc),
+             np.zeros(nxc), np.empty(nxp), np.empty(nxc), np.empty(nxp), np.empty(nxc))
     cmd, cmd_sample = np.zeros(plant.N_CMD), np.zeros(plant.N_CMD)
     buf = Buffers(np.zeros((3, 3)), np.zeros(WORK_SIZE), np.zeros(SCRATCH_SIZE), cmd)
     refm = buf.refm
@@ -380,8 +500,8 @@ def run(pb, cb, env, ref_p, settings, out):
     aux1, aux = np.zeros(max(naux, 1)), np.zeros(max(naux, 1))
     # the law's outputs of each RK4 stage, bundled once: a bundle built in the loop costs an atomic
     # reference-count increment and decrement per array at every stage (run is compiled with the runtime)
-    out1, out2, out3, out4 = (LawOutputs(tau1, kc1, aux1), LawOutputs(tau, kc2, aux), LawOutputs(tau, kc3, aux),
-                              LawOutputs(tau, kc4, aux))
+    out1 = LawOutputs(tau1, rk.kc1, aux1)
+    outs = (LawOutputs(tau, rk.kc2, aux), LawOutputs(tau, rk.kc3, aux), LawOutputs(tau, rk.kc4, aux))
     reuse = state_free_disturbance(env.rows)  # stage 3 may reuse stage 2's reference and omega
     t_late = 0.5 * (sf[SF.win_t0] + min(sf[SF.win_t1], n_steps * dt))  # second half of the planned window
     row = 0
@@ -392,24 +512,14 @@ def run(pb, cb, env, ref_p, settings, out):
             record_stop(xp, xc, xp, xc, fail_state)
             return CAUSE_INTERRUPTED, row, t
         if ctrl_every > 0 and k % ctrl_every == 0:  # sampled-data: measure, compute, allocate, hold
-            eval_reference(ref_p, t, refm)
-            eta_t, nu_t = plant.pose(xp)
-            eta, nu = measure(eta_t, nu_t, env.noise, k // ctrl_every)
-            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf, out1)
-            if status == 0 and not finite3(tau1):
-                status = STATUS_NONFINITE_INPUT
+            status, sat_k = sample(t, k, xp, xc, lp, buf, env.noise, out1, rk, cmd_sample)
             if status != 0:
                 record_stop(xp, xc, xp, xc, fail_state)
                 info[INFO_STATUS] = status
                 return CAUSE_CONTROLLER, row, t
-            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt, cmd_sample)
-            for i in range(cmd_sample.shape[0]):
-                cmd[i] = cmd_sample[i]
-            for i in range(nxc):  # the held controller derivative, for every stage until the next sample
-                kc2[i] = kc3[i] = kc4[i] = kc1[i]
+            sat = sat_k
         # stage 1 at (t, x): also the values that are logged and enter the metrics
-        att = plant_attitude(xp)
-        status, flags = stage(t, xp, xc, att, lp, buf, kp1, out1, True)
+        status, flags, applied, eta, e = first_stage(t, xp, xc, lp, buf, rk, out1)
         if ctrl_every == 0:
             sat = flags
         if status == 0 and ctrl_every == 0 and not finite3(tau1):
@@ -418,54 +528,22 @@ def run(pb, cb, env, ref_p, settings, out):
             record_stop(xp, xc, xp, xc, fail_state)
             info[INFO_STATUS] = status
             return CAUSE_CONTROLLER, row, t
-        applied = plant.applied(xp, cmd, pp)
-        eta, nu = plant.pose(xp)
-        p1 = virtual_point(eta, att, vp[VP.ell])
-        e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
         if k % log_every == 0 and row < log.shape[0]:
-            log_row(log, row, t, xp, cmd, pp, applied, refm, e, aux1, naux, kp1, vp)
+            log_row(log, row, t, xp, cmd, pp, applied, refm, e, aux1, naux, rk.kp1, vp)
             row += 1
         if k == n_steps:
             break
-        metrics_update(acc, t, dt, e, applied, sf[SF.win_t0], sf[SF.win_t1])
-        saturation_update(acc, t, dt, sat, sf[SF.win_t0], sf[SF.win_t1])
-        if si[SI.path_metrics] != 0:
-            path_update(acc, t, dt, (eta[0], eta[1], eta[2]), ref_p, sf[SF.win_t0], sf[SF.win_t1], t_late)
-        effort_update(acc, t, dt, plant.effort(xp, cmd, pp), sf[SF.win_t0], sf[SF.win_t1])
-        for i in range(nxp):
-            xps[i] = xp[i] + 0.5 * dt * kp1[i]
-        for i in range(nxc):
-            xcs[i] = xc[i] + 0.5 * dt * kc1[i]
-        status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, out2, True)
-        if status == 0:
-            for i in range(nxp):
-                xps[i] = xp[i] + 0.5 * dt * kp2[i]
-            for i in range(nxc):
-                xcs[i] = xc[i] + 0.5 * dt * kc2[i]
-            status, _ = stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, out3, not reuse)
-        if status == 0:
-            for i in range(nxp):
-                xps[i] = xp[i] + dt * kp3[i]
-            for i in range(nxc):
-                xcs[i] = xc[i] + dt * kc3[i]
-            status, _ = stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, out4, True)
+        status, cause = advance(t, dt, xp, xc, lp, buf, rk, e, applied, eta, sat, acc, settings, t_late, reuse,
+                                outs)
         if status != 0:
             record_stop(xp, xc, xp, xc, fail_state)
             info[INFO_STATUS] = status
             return CAUSE_CONTROLLER, row, t
-        for i in range(nxp):
-            xpn[i] = xp[i] + dt / 6.0 * (kp1[i] + 2.0 * kp2[i] + 2.0 * kp3[i] + kp4[i])
-        for i in range(nxc):
-            xcn[i] = xc[i] + dt / 6.0 * (kc1[i] + 2.0 * kc2[i] + 2.0 * kc3[i] + kc4[i])
         info[INFO_STEPS] = k + 1
-        cause = state_cause(xpn, xcn, sf)
         if cause != CAUSE_NONE:
-            record_stop(xpn, xcn, xp, xc, fail_state)
+            record_stop(rk.xpn, rk.xcn, xp, xc, fail_state)
             return cause, row, t + dt
-        for i in range(nxp):
-            xp[i] = xpn[i]
-        for i in range(nxc):
-            xc[i] = xcn[i]
+        take_step(xp, xc, rk)
     return CAUSE_NONE, row, n_steps * dt
 
 

@@ -31,7 +31,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from ..benchmark.suite import ControllerEntry, Suite, load_suite
+from ..benchmark.suite import Suite, load_suite
 from ..control.policy_observation import OBS, OBS_BOUND
 from ..engine.loop import CAUSES, SI, Stacked
 from ..metrics import metrics_finalize
@@ -41,7 +41,7 @@ from ..simulation.pipeline import Prepared, prepare
 from ..user_modules import load_module
 from ..vehicle.presets import get_preset
 from .replay import GAINS
-from .stepping import Carry, new_carry, step_module
+from .stepping import COST_TERMS, Carry, new_carry, step_module
 
 ACTIONS = {"tau": "auvtrack.gym.replay", "actuators": "auvtrack.gym.replay_actuators"}
 """Action modes -> the replay law that applies them."""
@@ -124,6 +124,41 @@ def action_scale(prep: Prepared, action: str) -> np.ndarray:
     return out
 
 
+SCORE_METRIC = {"error": "rmse", "energy": "energy", "tv": "tv", "xtrack": "xtrack_rmse", "vtrack": "vtrack_rmse",
+                "along": "along_rmse"}
+"""The suite ``[run_score]`` metric whose weight and scale each cost term takes (:data:`~auvtrack.gym.stepping.COST_TERMS`)."""
+MEAN_SQUARE = ("error", "xtrack", "vtrack", "along")
+"""Cost terms that are an RMS metric: charged as w min((rms/s)^2, cap^2), rms^2 = the sum over the task's duration."""
+
+
+def reward_weights(suite: Suite) -> tuple[tuple[float, ...], tuple[float, ...], float]:
+    """The reward's weights, caps and failure penalty from the suite's ``[run_score]`` (module docstring).
+
+    Parameters
+    ----------
+    suite : Suite
+        The suite.
+
+    Returns
+    -------
+    (tuple, tuple, float)
+        Per cost term: k = w / s^2 (RMS terms, still to be divided by the duration) or w / s; the cap
+        w cap^2 (RMS terms) or w cap; and the penalty, one more than the sum of the caps.  A suite
+        without a run score charges the virtual point's error alone (w = s = 1).
+    """
+    rs = suite.file.run_score
+    if not any(w > 0 for w in rs.weights.values()):
+        rs = rs.model_copy(update={"weights": {"rmse": 1.0}, "scales": {"rmse": 1.0}})
+    k, caps = [], []
+    for term in COST_TERMS:
+        metric = SCORE_METRIC[term]
+        w, s = rs.weights.get(metric, 0.0), rs.scales.get(metric, 1.0)
+        square = term in MEAN_SQUARE
+        k.append(w / s ** 2 if square else w / s)
+        caps.append(w * rs.cap ** 2 if square else w * rs.cap)
+    return tuple(k), tuple(caps), 1.0 + sum(caps)
+
+
 class TrackEnv(gym.Env):
     """One suite cell as an environment (module docstring).
 
@@ -156,13 +191,7 @@ class TrackEnv(gym.Env):
         episode_scenario(self.suite, self.task, self.tier, 0, action=action, substeps=substeps, duration=duration)
         self.observation_space = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, dtype=np.float64)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (3,), dtype=np.float64)
-        rs = self.suite.file.run_score
-        if not any(w > 0 for w in rs.weights.values()):  # a suite without a run score: the error alone
-            rs = rs.model_copy(update={"weights": {"rmse": 1.0}, "scales": {"rmse": 1.0}})
-        w = [rs.weights.get(k, 0.0) for k in ("rmse", "energy", "tv")]
-        caps = (w[0] * rs.cap ** 2, w[1] * rs.cap, w[2] * rs.cap)
-        self._weights = (w[0] / rs.scales.get("rmse", 1.0) ** 2, w[1] / rs.scales.get("energy", 1.0),
-                         w[2] / rs.scales.get("tv", 1.0), *caps, 1.0 + sum(caps))
+        self._weights = reward_weights(self.suite)
         self.prep: Prepared | None = None
         self.seed_index = 0
 
@@ -184,7 +213,9 @@ class TrackEnv(gym.Env):
         self.carry.xp[0] = prep.plant.x0
         self.carry.xc[0] = prep.controller.x0
         duration = float(prep.scenario.sim.duration)
-        self.carry.rw[0] = (self._weights[0] / duration, *self._weights[1:])
+        k, caps, penalty = self._weights
+        self.carry.rw[0] = (*(v / duration if term in MEAN_SQUARE else v for term, v in zip(COST_TERMS, k)),
+                            *caps, penalty)
         self.kernels = step_module(prep.key)
         self.kernels.observe_all(self.ins, self.carry, OBS_BOUND)
 

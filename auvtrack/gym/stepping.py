@@ -19,20 +19,24 @@ from ..control.contract import WORK_SIZE
 from ..engine import kernels
 from ..control.policy_observation import observe
 from ..engine.loop import (  # the engine's parts this step is built of (rebound in the generated module)
-    CAUSE_CONTROLLER, CAUSE_NONE, SF, SI, STATUS_NONFINITE_INPUT, VP, Buffers, LawOutputs, Loop, attitude,
-    control_sample, effort_update, eval_reference, finite3, measure, metrics_update, path_update, plant,
-    plant_attitude, prange, saturation_update, stage, state_cause, state_free_disturbance, virtual_point,
+    CAUSE_CONTROLLER, CAUSE_NONE, SF, SI, Buffers, LawOutputs, Loop, Settings, advance, attitude, first_stage,
+    Rk4, measure, plant, prange, sample, state_free_disturbance, take_step,
 )
-from ..metrics import METRICS_SIZE, OFF_E2, OFF_TEN, OFF_TV, metrics_init
+from ..metrics import METRICS_SIZE, OFF_E2, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2, metrics_init
 from ..plant.contract import SCRATCH_SIZE
 
-__all__ = ["Carry", "new_carry", "step_module", "episode_cost", "REWARD", "PARALLEL_FROM"]
+__all__ = ["Carry", "new_carry", "step_module", "episode_cost", "COST_TERMS", "REWARD", "PENALTY", "PARALLEL_FROM"]
 
 PARALLEL_FROM = 256
 """Envs from which a step runs in the thread pool (``step_all``) rather than in one thread (``step_serial``)."""
 
-REWARD = ("k_error", "k_energy", "k_tv", "cap_error", "cap_energy", "cap_tv", "penalty")
+COST_TERMS = ("error", "energy", "tv", "xtrack", "vtrack", "along")
+"""The episode cost's terms (:func:`episode_cost`), in the order of their weights and caps in ``Carry.rw``."""
+N_COST = len(COST_TERMS)
+REWARD = tuple(f"k_{n}" for n in COST_TERMS) + tuple(f"cap_{n}" for n in COST_TERMS) + ("penalty",)
 """Reward terms per env (row of ``Carry.rw``): see :func:`episode_cost`."""
+PENALTY = len(REWARD) - 1
+"""Index of the failure penalty in ``Carry.rw``."""
 
 
 class Carry(NamedTuple):
@@ -81,26 +85,26 @@ def new_carry(n: int, nxp: int, nxc: int, ncmd: int, nobs: int) -> Carry:
 def env_step(ins, c, i, bound):
     """One control period of env ``i``: write ``c.obs[i]``, ``c.reward[i]``, ``c.cause[i]``; return the cause.
 
-    The reward is minus the increment of :func:`episode_cost` over the period; a failure adds
-    ``-rw[6]``.  ``ks[i]`` = (RK4 step, saturation flags).  At the end of the run (step
-    ``n_steps``) nothing is integrated and the cause is 0.
+    The engine loop's step (:func:`~auvtrack.engine.loop.run`, sampled-data mode): the same
+    kernel parts (:func:`~auvtrack.engine.loop.sample`, ``first_stage``, ``advance``, ``take_step``)
+    in the same order, from step ``ks[i, 0]`` to the next control sample.  The reward is minus the
+    increment of :func:`episode_cost` over the period; a failure adds ``-rw[PENALTY]``.
+    ``ks[i]`` = (RK4 step, saturation flags).  At the end of the run (step ``n_steps``) nothing is
+    integrated and the cause is 0.
     """
-    pp, cp, vp, path = ins.pp[i], ins.cp[i], ins.vp[i], ins.path[i]
-    si, sf, noise = ins.si[i], ins.sf[i], ins.noise[i]
-    xp, xc, cmd, tau1, kc1, acc = c.xp[i], c.xc[i], c.cmd[i], c.tau1[i], c.kc1[i], c.acc[i]
+    si, sf = ins.si[i], ins.sf[i]
+    xp, xc, acc = c.xp[i], c.xc[i], c.acc[i]
     rw = c.rw[i]
     n_steps, ctrl_every = si[SI.n_steps], si[SI.ctrl_every]
     dt = sf[SF.dt]
     nxp, nxc = xp.shape[0], xc.shape[0]
-    xpn, xcn, xps, xcs = np.empty(nxp), np.empty(nxc), np.empty(nxp), np.empty(nxc)
-    kp1, kp2, kp3, kp4 = np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp)
-    kc2, kc3, kc4 = np.zeros(nxc), np.zeros(nxc), np.zeros(nxc)
-    cmd_sample = np.zeros(cmd.shape[0])
-    buf = Buffers(c.refm[i], c.work[i], c.scr[i], cmd)
-    refm = buf.refm
-    lp = Loop(pp, cp, vp, path, ins.rows[i], ins.current[i], ctrl_every, ctrl_every * dt)
-    tau = np.zeros(3)
-    aux1, aux = np.zeros(1), np.zeros(1)
+    rk = Rk4(np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), np.zeros(nxp), c.kc1[i], np.zeros(nxc), np.zeros(nxc),
+             np.zeros(nxc), np.empty(nxp), np.empty(nxc), np.empty(nxp), np.empty(nxc))  # kc1: the held law output
+    cmd_sample = np.zeros(c.cmd.shape[1])
+    buf = Buffers(c.refm[i], c.work[i], c.scr[i], c.cmd[i])
+    lp = Loop(ins.pp[i], ins.cp[i], ins.vp[i], ins.path[i], ins.rows[i], ins.current[i], ctrl_every, ctrl_every * dt)
+    out1, tau_s, aux_s = LawOutputs(c.tau1[i], rk.kc1, np.zeros(1)), np.zeros(3), np.zeros(1)
+    outs = (LawOutputs(tau_s, rk.kc2, aux_s), LawOutputs(tau_s, rk.kc3, aux_s), LawOutputs(tau_s, rk.kc4, aux_s))
     reuse = state_free_disturbance(ins.rows[i])
     t_late = 0.5 * (sf[SF.win_t0] + min(sf[SF.win_t1], n_steps * dt))
     before = episode_cost(rw, acc)
@@ -111,79 +115,47 @@ def env_step(ins, c, i, bound):
             break
         t = k * dt
         if k % ctrl_every == 0:
-            eval_reference(path, t, refm)
-            eta_t, nu_t = plant.pose(xp)
-            eta, nu = measure(eta_t, nu_t, noise, k // ctrl_every)
-            status = control_sample(t, eta, nu, attitude(eta[3], eta[4]), xc, xp, lp, buf,
-                                    LawOutputs(tau1, kc1, aux1))
-            if status == 0 and not finite3(tau1):
-                status = STATUS_NONFINITE_INPUT
+            status, sat_k = sample(t, k, xp, xc, lp, buf, ins.noise[i], out1, rk, cmd_sample)
             if status != 0:
                 cause = CAUSE_CONTROLLER
                 break
-            sat = plant.allocate((tau1[0], tau1[1], tau1[2]), eta, nu, xp, pp, cmd, ctrl_every * dt, cmd_sample)
-            for m in range(cmd_sample.shape[0]):
-                cmd[m] = cmd_sample[m]
-            for m in range(nxc):
-                kc2[m] = kc3[m] = kc4[m] = kc1[m]
-        att = plant_attitude(xp)
-        status, flags = stage(t, xp, xc, att, lp, buf, kp1, LawOutputs(tau1, kc1, aux1), True)
-        applied = plant.applied(xp, cmd, pp)
-        eta, nu = plant.pose(xp)
-        p1 = virtual_point(eta, att, vp[VP.ell])
-        e = (p1[0] - refm[0, 0], p1[1] - refm[0, 1], p1[2] - refm[0, 2])
-        metrics_update(acc, t, dt, e, applied, sf[SF.win_t0], sf[SF.win_t1])
-        saturation_update(acc, t, dt, sat, sf[SF.win_t0], sf[SF.win_t1])
-        path_update(acc, t, dt, (eta[0], eta[1], eta[2]), path, sf[SF.win_t0], sf[SF.win_t1], t_late)
-        effort_update(acc, t, dt, plant.effort(xp, cmd, pp), sf[SF.win_t0], sf[SF.win_t1])
-        for m in range(nxp):
-            xps[m] = xp[m] + 0.5 * dt * kp1[m]
-        for m in range(nxc):
-            xcs[m] = xc[m] + 0.5 * dt * kc1[m]
-        stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp2, LawOutputs(tau, kc2, aux), True)
-        for m in range(nxp):
-            xps[m] = xp[m] + 0.5 * dt * kp2[m]
-        for m in range(nxc):
-            xcs[m] = xc[m] + 0.5 * dt * kc2[m]
-        stage(t + 0.5 * dt, xps, xcs, plant_attitude(xps), lp, buf, kp3, LawOutputs(tau, kc3, aux), not reuse)
-        for m in range(nxp):
-            xps[m] = xp[m] + dt * kp3[m]
-        for m in range(nxc):
-            xcs[m] = xc[m] + dt * kc3[m]
-        stage(t + dt, xps, xcs, plant_attitude(xps), lp, buf, kp4, LawOutputs(tau, kc4, aux), True)
-        for m in range(nxp):
-            xpn[m] = xp[m] + dt / 6.0 * (kp1[m] + 2.0 * kp2[m] + 2.0 * kp3[m] + kp4[m])
-        for m in range(nxc):
-            xcn[m] = xc[m] + dt / 6.0 * (kc1[m] + 2.0 * kc2[m] + 2.0 * kc3[m] + kc4[m])
-        cause = state_cause(xpn, xcn, sf)
+            sat = sat_k
+        status, _, applied, eta, e = first_stage(t, xp, xc, lp, buf, rk, out1)
+        if status == 0:
+            status, cause = advance(t, dt, xp, xc, lp, buf, rk, e, applied, eta, sat, acc, Settings(si, sf), t_late,
+                                    reuse, outs)
+        if status != 0:
+            cause = CAUSE_CONTROLLER
         if cause != CAUSE_NONE:
             break
-        for m in range(nxp):
-            xp[m] = xpn[m]
-        for m in range(nxc):
-            xc[m] = xcn[m]
+        take_step(xp, xc, rk)
         k += 1
     c.ks[i, 0], c.ks[i, 1] = k, sat
-    c.reward[i] = before - episode_cost(rw, acc) - (rw[6] if cause != CAUSE_NONE else 0.0)
+    c.reward[i] = before - episode_cost(rw, acc) - (rw[PENALTY] if cause != CAUSE_NONE else 0.0)
     c.cause[i] = cause
     env_observe(ins, c, i, bound)
     return cause
 
 
 def episode_cost(rw, acc):
-    """The cost of the episode so far: sum over (error, energy, tv) of min(k * S, cap).
+    """The cost of the episode so far: sum over the terms of min(k * S, cap).
 
-    S are the metrics accumulator's sums over the axes: of squared error times dt, of squared
-    tau times dt, and tau's total variation; ``rw`` = (k_error, k_energy, k_tv, cap_error,
-    cap_energy, cap_tv, penalty) (:data:`REWARD`).  Capped, so that a completed episode costs at most
-    the sum of the caps (the failure penalty is more).
+    S are the metrics accumulator's sums (:mod:`auvtrack.metrics`), in the order of
+    :data:`COST_TERMS`: of squared virtual-point error times dt (m^2 s), of squared tau times dt,
+    tau's total variation, and the path-following sums at the navigation point over the window: squared
+    cross-track, vertical-track and along-track error times dt (m^2 s; zero with ``metrics.path = false``).
+    ``rw`` = (k_1 .. k_6, cap_1 .. cap_6, penalty) (:data:`REWARD`).  Capped, so that a completed episode
+    costs at most the sum of the caps (the failure penalty is more).
     """
     s_e, s_n, s_v = 0.0, 0.0, 0.0
     for j in range(3):
         s_e += acc[OFF_E2 + j]
         s_n += acc[OFF_TEN + j]
         s_v += acc[OFF_TV + j]
-    return min(rw[0] * s_e, rw[3]) + min(rw[1] * s_n, rw[4]) + min(rw[2] * s_v, rw[5])
+    n = N_COST
+    return (min(rw[0] * s_e, rw[n]) + min(rw[1] * s_n, rw[n + 1]) + min(rw[2] * s_v, rw[n + 2])
+            + min(rw[3] * acc[OFF_PATH + PATH_XT2], rw[n + 3]) + min(rw[4] * acc[OFF_PATH + PATH_VT2], rw[n + 4])
+            + min(rw[5] * acc[OFF_PATH + PATH_AL2], rw[n + 5]))
 
 
 def env_observe(ins, c, i, bound):
@@ -234,7 +206,8 @@ from numba import prange  # noqa: F401
 from auvtrack.engine.kernels import KernelKey, kernel_module
 from auvtrack.jit import njit  # noqa: F401
 from auvtrack.control.policy_observation import observe  # noqa: F401
-from auvtrack.metrics import OFF_E2, OFF_TEN, OFF_TV  # noqa: F401
+from auvtrack.metrics import OFF_E2, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2  # noqa: F401
+from auvtrack.gym.stepping import N_COST, PENALTY  # noqa: F401
 _k = kernel_module(KernelKey({key.law!r}, {key.plant!r}, {key.label!r}))
 globals().update({{n: getattr(_k, n) for n in dir(_k) if not n.startswith("__")}})
 '''

@@ -135,3 +135,47 @@ def test_a_failed_episode_returns_less_than_any_completed_one():
     assert te and info["status"] == "pitch_limit"
     worst_completed = -(9.0 + 0.5 * 3.0 + 0.25 * 3.0)  # every capped term at its cap
     assert ret < worst_completed - 1.0 + 1e-9
+
+
+PATHED = Suite(SuiteFile.model_validate(tomllib.loads(
+    TINY + "\n[run_score]\ncap = 3.0\n[run_score.weights]\nrmse = 0.25\nenergy = 0.1\nxtrack_rmse = 1.0\n"
+    "vtrack_rmse = 0.5\nalong_rmse = 0.25\n[run_score.scales]\nrmse = 1.0\nenergy = 500.0\nxtrack_rmse = 0.1\n"
+    "vtrack_rmse = 0.2\nalong_rmse = 2.0\n")), "tiny-pathed")
+
+
+def test_return_charges_the_path_metrics_of_the_run_score():
+    """With path weights: the return == -(capped squared-RMS terms of rmse, xtrack, vtrack, along + energy), from the metrics."""
+    env = TrackEnv(PATHED, "helix", "model", duration=1.0)
+    env.reset(seed=1)
+    rng = np.random.default_rng(3)
+    ret, done = 0.0, False
+    while not done:
+        _, r, te, tr, info = env.step(0.3 * rng.uniform(-1, 1, 3))
+        ret += r
+        done = te or tr
+    assert info["status"] == "ok"
+    m, dur = info["metrics"], info["t"] - env.prep.scenario.metrics.window[0]
+    terms = {"xtrack_rmse": (1.0, 0.1), "vtrack_rmse": (0.5, 0.2), "along_rmse": (0.25, 2.0)}
+    path = {k: w * min((m[k] / s) ** 2 * dur / 1.0, 9.0) for k, (w, s) in terms.items()}
+    assert all(v > 0 for v in path.values())  # the episode is charged for each path error
+    ms2 = sum(m[f"rmse_{a}"] ** 2 for a in "xyz") * dur
+    energy = sum(v for k, v in m.items() if k.startswith("energy_tau_"))
+    cost = 0.25 * min(ms2, 9.0) + 0.1 * min(energy / 500.0, 3.0) + sum(path.values())
+    assert ret == pytest.approx(-cost, rel=1e-9)
+
+
+def _v2_cells():
+    from auvtrack.gym.env import suite_of
+
+    suite = suite_of("auv-track-v2")
+    six = {t for t in suite.tiers if suite.file.tiers[t].requires_plant == "6dof"}
+    return [(task, tier, action) for task in suite.tasks for tier in suite.tiers
+            for action in (("tau", "actuators") if tier in six else ("tau",))]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("task, tier, action", _v2_cells())
+def test_check_env_every_cell_and_action_mode_of_auv_track_v2(task, tier, action):
+    """The checker on every task x tier of the shipped v2 suite, both action modes on the 6-DOF tiers (0.2 s episodes)."""
+    env = TrackEnv("auv-track-v2", task, tier, action=action, duration=0.2)
+    check_env(env, skip_render_check=True)

@@ -46,8 +46,9 @@ def test_running_statistics_equal_the_batch_statistics(sizes, seed):
         np.testing.assert_allclose(s.std(), allx.std(axis=0, ddof=1), rtol=1e-9)
 
 
-def test_killed_and_resumed_equals_uninterrupted(tmp_path, suite_file):
-    cfg = _cfg(suite_file)
+@pytest.mark.parametrize("method", ["ars", "cmaes"])
+def test_killed_and_resumed_equals_uninterrupted(tmp_path, suite_file, method):
+    cfg = _cfg(suite_file, method=method)
     whole = train(cfg, tmp_path / "whole")
 
     def kill(row):
@@ -87,6 +88,7 @@ def test_seeds_come_from_the_splits(tmp_path, suite_file, monkeypatch):
     assert prov["training_seeds"] == [100, 108] and prov["validation_seeds"] == [200, 204]
     assert prov["budget"]["episodes"] == res.episodes == 4 * 2 * 2 * 2
     assert prov["command"].startswith("auvtrack train --suite") and "ARS" in prov["method"]
+    assert prov["reward"] == {"error": [1.0, 100.0]}  # no run score: the error alone, w = s = 1, cap 10 squared
 
 
 def test_quick_improves_the_held_out_return(tmp_path, suite_file, capsys):
@@ -105,7 +107,22 @@ def test_quick_improves_the_held_out_return(tmp_path, suite_file, capsys):
     assert "held-out return: initial policy" in capsys.readouterr().out
 
 
+def test_cmaes_quick_improves_the_held_out_return(tmp_path, suite_file):
+    """CI-sized CMA-ES: tiny suite (calm tier, both tasks, 1 s quick episodes), seed 0, 8 iterations, lambda = 8."""
+    out = tmp_path / "cma"
+    code = main(["train", "--quick", "--method", "cmaes", "--suite", str(suite_file), "--tier", "calm",
+                 "--directions", "4", "--noise", "0.05", "--seeds-per-iteration", "1", "--eval-every", "4",
+                 "--seed", "0", "--out", str(out), "--quiet"])
+    assert code == 0
+    curve = json.loads(str(np.load(out / "checkpoint.npz")["curve"]))
+    first, last = curve[0]["validation_return"], curve[-1]["validation_return"]
+    assert last > first, (first, last)
+    prov = load_policy(out / "policy.npz")["header"]["provenance"]
+    assert "CMA-ES" in prov["method"] and "--method cmaes" in prov["command"]
+
+
 @pytest.mark.parametrize("args, field", [(["--top", "9"], "--top"), (["--noise", "0"], "--noise"),
+                                        (["--method", "sgd"], "--method"), (["--action", "fins"], "--action"),
                                         (["--tier", "nope"], "tier"), (["--task", "nope"], "tasks")])
 def test_bad_settings_one_line(tmp_path, suite_file, capsys, args, field):
     code = main(["train", "--suite", str(suite_file), "--out", str(tmp_path / "o"), *args])
@@ -118,3 +135,40 @@ def test_suite_without_splits_refused(tmp_path, capsys):
     path.write_text(TINY)
     assert main(["train", "--suite", str(path), "--out", str(tmp_path / "o")]) == 2
     assert "splits.training" in capsys.readouterr().err
+
+
+@pytest.fixture
+def dask_client():
+    """A local Dask cluster (two worker threads), always closed."""
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        yield client
+
+
+@pytest.mark.parametrize("method", ["ars", "cmaes"])
+def test_rollouts_on_dask_equal_the_local_training(tmp_path, suite_file, dask_client, method):
+    """Both training tasks' rollouts on the cluster: the same policy, statistics and curve bit for bit."""
+    cfg = _cfg(suite_file, method=method, tasks=("line", "helix"))
+    local = train(cfg, tmp_path / "local")
+    remote = train(cfg, tmp_path / "dask", client=dask_client)
+    assert np.any(local.M != 0)
+    assert np.array_equal(remote.M, local.M) and np.array_equal(remote.mean, local.mean)
+    assert np.array_equal(remote.std, local.std)
+    drop = lambda curve: [{k: v for k, v in r.items() if k != "wall_s"} for r in curve]
+    assert drop(remote.curve) == drop(local.curve)
+    assert train_mod._REMOTE_ENVS  # the worker threads of this process kept their environments
+
+
+def test_scheduler_nobody_answers_is_one_line(tmp_path, suite_file, capsys):
+    import socket
+
+    sock = socket.socket()
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    sock.close()  # a closed port
+    code = main(["train", "--suite", str(suite_file), "--out", str(tmp_path / "o"), "--scheduler",
+                 f"tcp://127.0.0.1:{port}"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "--scheduler" in err, err
