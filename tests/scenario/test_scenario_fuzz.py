@@ -11,6 +11,7 @@ from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
 from auvtrack.control import CONTROLLERS
+from auvtrack.plant import get as get_plant
 from auvtrack.scenario import ScenarioError, load_scenario
 from auvtrack.simulation.pipeline import prepare
 from doc_ranges import documented_ranges
@@ -89,10 +90,16 @@ def assert_error_names(data, path: str) -> None:
 # --- forbidden ranges, read from the documented table (docs/scenarios.md), never from the schema -
 
 # every registered controller's rows of the [controller] table are checked on the paper scenario
-_NEEDS = {"open_loop_actuators": ["plant.model=6dof"],  # commands fins and propeller (issue 11)
-          "plugin": [f'controller.module="{Path(__file__).resolve().parents[2] / "examples" / "plugin_controller.py"}"']}
-BASES = {"": BASE, **{kind: load_scenario(PAPER, [f"controller.kind={kind}", *_NEEDS.get(kind, [])]).to_dict()
-                      for kind in CONTROLLERS}}
+# (a controller that cannot fly the paper's 5-DOF plant, e.g. one commanding fins and propeller, on the 6-DOF one)
+_NEEDS = {"plugin": [f'controller.module="{Path(__file__).resolve().parents[2] / "examples" / "plugin_controller.py"}"']}
+
+
+def _base(kind: str) -> dict:
+    plant = [] if CONTROLLERS[kind].runs_on(get_plant("5dof")) else ["plant.model=6dof"]
+    return load_scenario(PAPER, [f"controller.kind={kind}", *plant, *_NEEDS.get(kind, [])]).to_dict()
+
+
+BASES = {"": BASE, **{kind: _base(kind) for kind in CONTROLLERS}}
 DOCUMENTED = [(rng, BASES.get(kind)) for kind, rngs in documented_ranges(BASE).items() for rng in rngs
               if kind in BASES]
 
