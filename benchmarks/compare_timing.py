@@ -54,12 +54,17 @@ def _row(label: str, out: Path, wall: float | None, complete: bool) -> dict:
     runs = pd.read_parquet(out / "runs.parquet", columns=["task", "steps"])
     dt_ = float(doc["suite"]["file"]["base"].get("sim.dt", 0.002))
     full = runs["task"].map(lambda t: round(doc["suite"]["durations"][t] / dt_)).sum()
-    return {"variant": label, "out": str(out), "runs": timing["runs"], "seeds": doc["suite"]["seeds"],
+    return {"variant": label, "out": _folder(out), "runs": timing["runs"], "seeds": doc["suite"]["seeds"],
             "controllers": len(doc["controllers"]), "tiers": len(doc["suite"]["file"]["tiers"]) -
             len(doc["suite"]["skipped_tiers"]), "wall_seconds": wall, "after_compilation_seconds": after,
             "target_seconds": target, "meets_target": None if target is None else after <= target,
             "steps": int(runs["steps"].sum()), "steps_full": int(full), "source_hash": doc["source_hash"],
             "complete": complete, "measured_in": "this call" if wall is not None else "--default-from", **timing}
+
+
+def _folder(out: Path) -> str:
+    """The comparison's folder as its last two parts (``simd/quick``): a record, not a path on this machine."""
+    return "/".join(Path(out).parts[-2:])
 
 
 def _existing_default(folder: Path, suite: str) -> dict:

@@ -64,6 +64,12 @@ def _plugin_tuning(entry: ControllerEntry, tuned_dir: Path | None) -> Mapping[st
     return json.loads(path.read_text()).get("provenance")
 
 
+def _suite_id(provenance: dict) -> str:
+    """The suite a tuning ran on, as ``"<name> v<version>"`` (``auvtrack tune`` records the two apart)."""
+    suite = str(provenance["suite"])
+    return f"{suite} v{provenance['suite_version']}" if "suite_version" in provenance else suite
+
+
 def tuning_rows(entries: Sequence[ControllerEntry], tuned_dir: Path | None = None) -> list[list[str]]:
     """One row per competitor (:data:`TUNING_COLUMNS`) from its gain preset's provenance.
 
@@ -93,7 +99,7 @@ def tuning_rows(entries: Sequence[ControllerEntry], tuned_dir: Path | None = Non
         if p is None:
             p = preset.provenance
         tool = str(p.get("tool") or p.get("study") or "not recorded")
-        on = f"{p['suite']}, {p.get('split', '?')} split" if "suite" in p else \
+        on = f"{_suite_id(p)}, {p.get('split', '?')} split" if "suite" in p else \
             ", ".join(map(str, p.get("train_cases", []))) or "not recorded"
         gains = "tuned params (`compare --tune`)" if preset is None else f"preset {preset.name}"
         rows.append([e.label, gains, tool, on, _budget(p), _cost(p), _objective(p)])

@@ -315,14 +315,14 @@ def test_sim_step_counts():
 
 def test_controller_union_covers_registry():
     from auvtrack.control import CONTROLLERS
+    from auvtrack.plant import get as get_plant
 
     kinds = {m.model_fields["kind"].default for m in CONTROLLER_MODELS}
     assert kinds == set(CONTROLLERS)
     example = Path(__file__).resolve().parents[2] / "examples" / "plugin_controller.py"
-    needs_6dof = {"open_loop_actuators"}  # commands fins and propeller (issue 11)
-    for kind in kinds:  # a plug-in needs its module
+    for kind in kinds:  # a plug-in needs its module; a law commanding the actuators needs a plant that has them
         extra = [f"controller.module=\"{example}\""] if kind == "plugin" else []
-        extra += ["plant.model=6dof"] if kind in needs_6dof else []
+        extra += [] if CONTROLLERS[kind].runs_on(get_plant("5dof")) else ["plant.model=6dof"]
         assert load_scenario({}, [f"controller.kind={kind}", *extra]).controller.kind == kind
     with pytest.raises(ScenarioError, match="controller.module: required key is missing"):
         load_scenario({}, ["controller.kind=plugin"])
