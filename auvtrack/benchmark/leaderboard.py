@@ -51,10 +51,11 @@ METRIC_INFO: dict[str, tuple[str, str]] = {
 """Metric name -> (description, unit)."""
 
 _ENGINE_INFO: dict[str, str] = {
-    "xtrack_rmse": "RMS cross-track (horizontal) distance to the path",
+    "xtrack_rmse": "RMS cross-track (horizontal) distance of the navigation point to the path",
     "xtrack_max": "largest cross-track distance to the path",
     "vtrack_rmse": "RMS vertical distance to the path",
-    "along_rmse": "RMS along-path error (timing on the path)",
+    "along_rmse": "RMS along-path timing error of the navigation point (a virtual-point tracker trails by "
+                  "its lever l by design)",
     "act_rms": "RMS position of the {}", "act_max": "largest position of the {}",
     "act_rate": "rate of the {}", "t_act_limit": "time at the limit of the {}",
 }

@@ -144,7 +144,8 @@ def figure_distribution(df, metric: str, tiers: Sequence[str], controllers: Sequ
 
 
 def figure_trajectories(reps: Mapping, task: str, tiers: Sequence[str], controllers: Sequence[str], seeds: Mapping):
-    """Representative runs of one task: top view of the virtual point and |e|(t), one row per tier."""
+    """Representative runs of one task, one row per tier: top view of the navigation point (where the path
+    metrics are measured) on the path, and the virtual point's |e|(t) (what a tracking law drives to zero)."""
     from matplotlib.figure import Figure
 
     colors = _colors(controllers)
@@ -162,7 +163,7 @@ def figure_trajectories(reps: Mapping, task: str, tiers: Sequence[str], controll
             if not drawn_ref:
                 ax_xy.plot(ch["yd"], ch["xd"], "k--", lw=1, label="reference")
                 drawn_ref = True
-            ax_xy.plot(ch["yd"] + ch["ey"], ch["xd"] + ch["ex"], color=colors[c], lw=1, label=c)
+            ax_xy.plot(ch["y"], ch["x"], color=colors[c], lw=1, label=c)
             e = np.sqrt(ch["ex"] ** 2 + ch["ey"] ** 2 + ch["ez"] ** 2)
             ax_e.semilogy(ch["t"], np.maximum(e, 1e-9), color=colors[c], lw=1,
                           label=c + ("" if res.ok else f" ({res.failure['cause']} at {res.failure['time']:.1f} s)"))
@@ -171,7 +172,7 @@ def figure_trajectories(reps: Mapping, task: str, tiers: Sequence[str], controll
         ax_xy.set_ylabel("north x (m)")
         ax_xy.set_title(f"{task} / {t}: seed index {seeds.get((t, task), '?')}", fontsize=9)
         ax_e.set_xlabel("t (s)")
-        ax_e.set_ylabel("|e| (m)")
+        ax_e.set_ylabel("virtual-point |e| (m)")
         ax_e.grid(alpha=0.3)
         ax_e.legend(fontsize=6)
     axes[0][0].legend(fontsize=6)
@@ -361,7 +362,10 @@ def write_report(out: Path, suite: Suite, entries: Sequence[ControllerEntry], df
 
     rep.heading("Representative trajectories")
     rep.paragraph(f"Per tier, the seed at the median of the controllers' median `{primary}`, re-run with its trajectory "
-                  "(the same seed for every controller).")
+                  "(the same seed for every controller). Left: the navigation point's track (where the path metrics "
+                  "are measured) over the path; right: the virtual point's error |e|, the point a tracking law "
+                  "steers, ℓ ahead of the navigation point (a path follower such as the LOS autopilot puts the "
+                  "navigation point on the path, so its |e| stays about ℓ by design).")
     for task in tasks:
         rep.figure(figure_trajectories(reps, task, tiers, order, seeds), f"traj_{task}", f"{task}")
 
