@@ -144,8 +144,11 @@ def figure_distribution(df, metric: str, tiers: Sequence[str], controllers: Sequ
 
 
 def figure_trajectories(reps: Mapping, task: str, tiers: Sequence[str], controllers: Sequence[str], seeds: Mapping):
-    """Representative runs of one task, one row per tier: top view of the navigation point (where the path
-    metrics are measured) on the path, and the virtual point's |e|(t) (what a tracking law drives to zero)."""
+    """Representative runs of one task, one row per tier.
+
+    Left: top view of the navigation point (where the path metrics are measured) on the path. Right: the
+    virtual point's |e|(t), the error a tracking law drives to zero.
+    """
     from matplotlib.figure import Figure
 
     colors = _colors(controllers)
