@@ -131,8 +131,8 @@ class ChunkJob:
         return None
 
     # ---------------------------------------------------------------- how a chunk is computed
-    def warm_local(self, workers: int | None) -> float:
-        """Compile or load what the local runs need before they are timed; the seconds it took."""
+    def warm_local(self, workers: int | None, progress: bool = True) -> float:
+        """Compile or load what the local runs need before they are timed (``progress``: a bar); the seconds it took."""
         return 0.0
 
     def run_local(self, ids: range, workers: int | None):
@@ -428,7 +428,7 @@ class _Run:
         return self.max_chunks is not None and self.written >= self.max_chunks
 
     def local(self, workers: int | None) -> None:
-        self.warm_seconds = self.job.warm_local(workers)
+        self.warm_seconds = self.job.warm_local(workers, self.progress)
         self._open_bar()
         t0 = time.perf_counter()
         try:

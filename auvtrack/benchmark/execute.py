@@ -28,7 +28,7 @@ from ..batch.chunk_files import chunk_path
 from ..batch.executor import ChunkJob, check_workers, execute_chunks
 from ..control.plugin import PluginFailure
 
-__all__ = ["RunSpec", "plan_size", "check_plan", "check_plugin_setups", "plan_runs", "run_planned", "run_chunk", "execute", "ExecOutcome",
+__all__ = ["RunSpec", "plan_size", "check_plan", "check_plugin_setups", "plan_runs", "run_planned", "run_chunk", "warm_runs", "execute", "ExecOutcome",
            "CompareJob", "CompareError", "chunk_path", "MANIFEST", "RUNS_FILE", "FIXED_COLUMNS", "DEFAULT_MAX_RUNS",
            "MAX_RUNS"]
 
@@ -363,14 +363,34 @@ def _warm_specs(suite, entries: Sequence) -> list[RunSpec]:
     return list(seen.values())
 
 
-def _warm(specs: Sequence[RunSpec], workers: int | None = None, backend: str | None = None) -> float:
-    """Compile or load everything the runs need before the timed runs start.
+def warm_runs(specs: Sequence[RunSpec], workers: int | None = None, backend: str | None = None, *,
+              progress: bool = True, notice: Callable[[str], None] | None = None) -> float:
+    """Compile or load everything the runs ``specs`` need before the timed runs start.
 
     One run per (controller, tier, plant preset) is prepared (set-up helpers compile on first
     use), its kernel compiled or loaded, and then flown for 0.5 s: a kernel compiles one
     specialisation per type signature of its bundles, and the tiers' bundles differ, so this
     loads every signature the runs will call.  With the ``simd`` back end each is flown in a full
     block of lanes, so that the lane kernels too compile here.
+
+    Parameters
+    ----------
+    specs : sequence of RunSpec
+        The runs about to be flown (one per key is enough, e.g. :func:`plan_runs` of a chunk).
+    workers : int or None, optional
+        Threads of the batch runner for the short flights.
+    backend : str, optional
+        Back end of the batch runner (``simd`` also compiles the lane kernels).
+    progress : bool, optional
+        A progress bar over the kernels compiled.
+    notice : callable, optional
+        Receives the "compiling kernels (first run only, about N s)" line when a kernel is not
+        cached (default: standard error).
+
+    Returns
+    -------
+    float
+        Wall time of the warm-up in seconds.
     """
     from ..batch.runner import run_batch
     from ..simulation.compiling import ensure_compiled
@@ -386,7 +406,7 @@ def _warm(specs: Sequence[RunSpec], workers: int | None = None, backend: str | N
             p = _prepare(short)
             if not isinstance(p, str):
                 seen[key] = p
-    ensure_compiled(list(seen.values()), progress=True)
+    ensure_compiled(list(seen.values()), progress=progress, notice=notice)
     if seen:
         warm = list(seen.values())
         if backend == "simd":  # a block of lanes per signature: the lane kernels compile here, not in the timed runs
@@ -476,9 +496,9 @@ class CompareJob(ChunkJob):
         doc = {**self.definition(), "source": source_hash()}
         return hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()
 
-    def warm_local(self, workers: int | None) -> float:
-        """:func:`_warm` of one run per (controller, tier, plant preset)."""
-        return _warm(_warm_specs(self.suite, self.entries), workers, self.backend)
+    def warm_local(self, workers: int | None, progress: bool = True) -> float:
+        """:func:`warm_runs` of one run per (controller, tier, plant preset)."""
+        return warm_runs(_warm_specs(self.suite, self.entries), workers, self.backend, progress=progress)
 
     def run_local(self, ids: range, workers: int | None):
         """The runs ``ids`` over ``workers`` threads of the batch runner."""

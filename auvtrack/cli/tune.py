@@ -29,10 +29,14 @@ from .signals import stop_once
                    "first); its workers must reach --out.")
 @click.option("--backend", default=None, metavar="NAME", help="Back end of the batch runner.")
 @click.option("--no-validate", is_flag=True, help="Do not fly the best gains on the validation split.")
-@click.option("--quiet", is_flag=True, help="No progress line.")
+@click.option("--quiet", is_flag=True, help="No progress line, no compile notice or bar, no Optuna log or warnings.")
 def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, seed: int, workers: int,
          parallel: int, scheduler: str | None, backend: str | None, no_validate: bool, quiet: bool) -> None:
-    """Tune a controller for the suite's vehicle with Optuna; Ctrl-C keeps the study, run again to resume."""
+    """Tune a controller for the suite's vehicle with Optuna; Ctrl-C or SIGTERM keeps the study, run again to resume.
+
+    The kernels the trials fly are compiled (or loaded) before the first trial, with the
+    "compiling kernels (first run only, about N s)" notice and a progress bar on a first run.
+    """
     from ..benchmark.suite import SuiteError
     from ..tuning import tune as _tune
 
@@ -44,7 +48,7 @@ def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, 
         try:
             res = _tune(controller, suite_name, trials=budget, out=out, sampler=sampler, seed=seed,
                         validate=not no_validate, workers=workers, backend=backend, parallel=parallel,
-                        scheduler=scheduler, progress=progress)
+                        scheduler=scheduler, progress=progress, compile_bar=not quiet, quiet=quiet)
         except (SuiteError, ValueError) as exc:
             raise BadInput(one_line(exc)) from None
         except KeyboardInterrupt:

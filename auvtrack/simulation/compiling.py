@@ -6,7 +6,7 @@ functions name the pairs from the registries and hand them to the engine's compi
 from __future__ import annotations
 
 import time
-from typing import Sequence
+from typing import Callable, Sequence
 
 from ..engine import kernels
 
@@ -54,7 +54,8 @@ def builtin_pairs(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (
             if CONTROLLERS[c].runs_on(PLANTS[p])]
 
 
-def ensure_compiled(preps: Sequence, *, progress: bool = False) -> None:
+def ensure_compiled(preps: Sequence, *, progress: bool = False,
+                    notice: Callable[[str], None] | None = None) -> None:
     """Compile (or load) the kernels that ``preps`` need, with the "compiling kernels" notice if any is new.
 
     Parameters
@@ -63,8 +64,10 @@ def ensure_compiled(preps: Sequence, *, progress: bool = False) -> None:
         Runs about to start.
     progress : bool, optional
         Show a progress bar over the kernels being compiled.
+    notice : callable, optional
+        Receives the notice (default: printed to standard error).
     """
-    kernels.warmup([p.key for p in preps], progress=progress)
+    kernels.warmup([p.key for p in preps], progress=progress, notice=notice)
 
 
 def kernel_keys(pairs: Sequence[tuple[str, str]]) -> list[kernels.KernelKey]:

@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import json
 import math
+import sys
+import warnings
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 __all__ = ["preset_name", "preset_text", "write_outputs"]
 
@@ -83,7 +85,7 @@ def _study(res):
 
 
 def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sampler: str, seed: int,
-                  runs_per_trial: int) -> dict[str, Path]:
+                  runs_per_trial: int, notify: Callable[[str], None] | None = None) -> dict[str, Path]:
     """Write the preset, ``results.json`` and the report of a finished tuning into ``out``.
 
     Parameters
@@ -100,6 +102,9 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
         Sampler seed.
     runs_per_trial : int
         Training runs of one trial (the budget is trials x runs_per_trial).
+    notify : callable, optional
+        Receives one line when Optuna warns about the parameter importances (too few trials);
+        default standard error.
 
     Returns
     -------
@@ -118,10 +123,16 @@ def write_outputs(res, out: str | Path, *, vehicle: str, suite_name: str, sample
     study = _study(res)
     trials = [{"number": t.number, "state": t.state.name, "value": t.value, "params": t.params,
                "user_attrs": t.user_attrs} for t in study.get_trials()]
-    try:
-        importances = {k: float(v) for k, v in optuna.importance.get_param_importances(study).items()}
-    except (RuntimeError, ValueError, ZeroDivisionError):  # too few complete trials
-        importances = {}
+    with warnings.catch_warnings(record=True) as caught:  # Optuna's warning becomes one line of ours
+        warnings.simplefilter("always")
+        try:
+            importances = {k: float(v) for k, v in optuna.importance.get_param_importances(study).items()}
+        except (RuntimeError, ValueError, ZeroDivisionError):  # too few complete trials
+            importances = {}
+    if caught:
+        say = notify or (lambda text: print(text, file=sys.stderr, flush=True))
+        say(f"note: parameter importances: {' '.join(str(caught[0].message).split())} ({res.trials} finished "
+            f"trial{'s' if res.trials != 1 else ''})")
     cost = res.study_cost
     provenance = {"tool": "auvtrack tune", "suite": res.suite, "suite_version": res.suite_version,
                   "split": res.split, "budget_trials": res.trials, "runs_per_trial": runs_per_trial,

@@ -17,13 +17,13 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Mapping
+from typing import Any, Callable, Iterator, Mapping
 
 from .objective import candidate_table, evaluate, split_specs
 from .space import Dimension, constraint_violations, distributions, field_values, search_space, searched_fields
 
 __all__ = ["SAMPLERS", "STUDY_NAME", "TrialJob", "TuneResult", "add_trials", "controller_base", "designed_base",
-           "trial_seed", "tune"]
+           "trial_seed", "tune", "warm_trials"]
 
 SAMPLERS = ("tpe", "cmaes")
 STUDY_NAME = "tune"
@@ -158,10 +158,40 @@ def _storage(url: str):
     return optuna.storages.RDBStorage(url, engine_kwargs={"connect_args": {"timeout": SQLITE_TIMEOUT_S}})
 
 
+def _log_level() -> None:
+    """Optuna's log at warnings and above (a quieter level set by ``--quiet`` is kept)."""
+    import optuna
+
+    optuna.logging.set_verbosity(max(optuna.logging.get_verbosity(), optuna.logging.WARNING))
+
+
+@contextlib.contextmanager
+def silenced() -> Iterator[None]:
+    """Optuna's log messages and warnings silenced (``tune --quiet``); both are restored on exit.
+
+    Yields
+    ------
+    None
+        With Optuna's log at errors only and warnings ignored.
+    """
+    import warnings
+
+    import optuna
+
+    level = optuna.logging.get_verbosity()
+    optuna.logging.set_verbosity(optuna.logging.ERROR)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        optuna.logging.set_verbosity(level)
+
+
 def _open_study(out: Path, sampler: str, seed: int):
     import optuna
 
-    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    _log_level()
     url = f"sqlite:///{(out / STUDY_FILE).resolve()}"
     study = optuna.create_study(study_name=STUDY_NAME, storage=_storage(url), direction="minimize",
                                 load_if_exists=True, sampler=_sampler(sampler, seed))
@@ -187,7 +217,7 @@ def load_study(url: str, sampler: str, seed: int):
     """
     import optuna
 
-    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    _log_level()
     return optuna.load_study(study_name=STUDY_NAME, storage=_storage(url), sampler=_sampler(sampler, seed))
 
 
@@ -314,6 +344,8 @@ class TrialJob:
         Back end of the batch runner.
     chunk : int or None
         Runs per batch inside a trial (default one (task, tier) cell).
+    quiet : bool
+        Optuna's log and warnings silenced in the worker (:func:`silenced`).
     """
 
     base: dict
@@ -326,6 +358,7 @@ class TrialJob:
     workers: int | None = 1
     backend: str | None = None
     chunk: int | None = None
+    quiet: bool = False
 
 
 def designed_base(spec, base: Mapping[str, Any], space: Mapping[str, Dimension]) -> dict:
@@ -499,6 +532,13 @@ def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
     dict
         ``runs``, ``steps`` and ``cpu_s`` this worker spent.
     """
+    if job.quiet:
+        with silenced():
+            return _add_trials(job, worker, progress)
+    return _add_trials(job, worker, progress)
+
+
+def _add_trials(job: TrialJob, worker: int, progress) -> dict:
     from optuna.trial import TrialState
 
     from ..benchmark.suite import load_suite
@@ -532,10 +572,55 @@ def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
     return cost
 
 
+def warm_trials(st, base: Mapping[str, Any], space: Mapping[str, Dimension], first, splits: list[str],
+                validation: bool, *, workers: int | None = 1, backend: str | None = None,
+                notify: Callable[[str], None] | None = None, bar: bool = False) -> float:
+    """Compile or load the kernels a tuning's trials fly, before the first trial.
+
+    The untuned candidate's runs of the splits (one per tier and plant preset) go through
+    :func:`auvtrack.benchmark.execute.warm_runs`: the other candidates differ in their gains only,
+    so they fly the same kernels.
+
+    Parameters
+    ----------
+    st : auvtrack.benchmark.suite.Suite
+        The suite.
+    base : mapping
+        The candidates' ``[controller]`` table without the gains (:func:`designed_base`).
+    space : mapping of str to Dimension
+        The search space.
+    first : RunSpec
+        A run of the split with the bare table (:func:`untuned_gains`).
+    splits : list of str
+        The splits the trials fly in this process (empty when they fly on Dask).
+    validation : bool
+        Also the validation split's runs (the best gains are flown there at the end).
+    workers : int or None, optional
+        Threads of the batch runner.
+    backend : str, optional
+        Back end of the batch runner.
+    notify : callable, optional
+        Receives the "compiling kernels" notice (default: standard error).
+    bar : bool, optional
+        A progress bar over the kernels compiled.
+
+    Returns
+    -------
+    float
+        Wall seconds of the warm-up.
+    """
+    from ..benchmark.execute import warm_runs
+
+    table = candidate_table(base, field_values(space, untuned_gains(first, space)))
+    specs = [s for name in [*splits, *(["validation"] if validation else [])] for s in split_specs(st, table, name)]
+    return warm_runs(specs, workers, backend, progress=bar, notice=notify)
+
+
 def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, out: str | Path,
          sampler: str = "tpe", seed: int = 0, split: str = "training", validate: bool = True,
          workers: int | None = 1, backend: str | None = None, chunk: int | None = None,
-         parallel: int = 1, scheduler: str | None = None, client: Any = None, progress=None) -> TuneResult:
+         parallel: int = 1, scheduler: str | None = None, client: Any = None, progress=None,
+         notify: Callable[[str], None] | None = None, compile_bar: bool = False, quiet: bool = False) -> TuneResult:
     """Tune one controller's declared gains on a suite's split; resumes the study found in ``out``.
 
     Parameters
@@ -572,6 +657,15 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
         An existing Dask client (overrides ``scheduler``; left open).
     progress : callable, optional
         ``progress(done, total)`` after each trial (in this process only).
+    notify : callable, optional
+        Receives the one-line notices: "compiling kernels (first run only, about N s)" when a kernel
+        the trials need is not cached, and why the parameter importances are not computed (default:
+        standard error).
+    compile_bar : bool, optional
+        A progress bar over the kernels compiled before the first trial.
+    quiet : bool, optional
+        Print nothing: no notice, no bar, Optuna's log and warnings silenced (:func:`silenced`, in
+        the local worker processes too).
 
     Returns
     -------
@@ -584,6 +678,16 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
         One line: bad controller, sampler, split, trials or parallel; a controller declaring no
         tunable gain; a scheduler that does not answer.
     """
+    if not quiet:
+        return _tune(controller, suite, trials, out, sampler, seed, split, validate, workers, backend, chunk,
+                     parallel, scheduler, client, progress, notify, compile_bar, False)
+    with silenced():
+        return _tune(controller, suite, trials, out, sampler, seed, split, validate, workers, backend, chunk,
+                     parallel, scheduler, client, progress, lambda text: None, False, True)
+
+
+def _tune(controller, suite, trials, out, sampler, seed, split, validate, workers, backend, chunk, parallel,
+          scheduler, client, progress, notify, compile_bar, quiet) -> TuneResult:
     from ..benchmark.suite import load_suite
     from .parallel import run_workers
 
@@ -614,8 +718,13 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
         if not study.get_trials(deepcopy=False):  # the first candidate: the untuned (designed) gains
             study.enqueue_trial(untuned_gains(probe[0], space), user_attrs={"first_candidate": "untuned"})
     suite_ref = str(Path(suite).resolve()) if Path(str(suite)).suffix == ".toml" else str(suite)
-    job = TrialJob(fixed, suite_ref, split, trials, url, sampler, seed, workers, backend, chunk)
+    job = TrialJob(fixed, suite_ref, split, trials, url, sampler, seed, workers, backend, chunk, quiet)
     res = TuneResult(controller=base, suite=st.name, suite_version=st.file.version, split=split, study=url)
+    local = scheduler is None and client is None  # the trials fly on this machine
+    validating = validate and st.file.splits.validation is not None
+    if local or validating:  # compile here, before the first trial (the local workers load the cached kernels)
+        warm_trials(st, fixed, space, probe[0], [split] if local else [], validating, workers=workers,
+                    backend=backend, notify=notify, bar=compile_bar)
     t_wall, t_cpu = time.perf_counter(), time.process_time()
     if parallel == 1 and scheduler is None and client is None:
         costs = [add_trials(job, 0, progress)]
@@ -641,7 +750,7 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
 
     vehicle = str(st.file.base.get("vehicle.preset", "paper"))
     res.outputs = write_outputs(res, out, vehicle=vehicle, suite_name=st.name, sampler=sampler, seed=seed,
-                                runs_per_trial=len(probe))
+                                runs_per_trial=len(probe), notify=notify)
     return res
 
 

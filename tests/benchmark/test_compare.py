@@ -149,7 +149,7 @@ def test_simd_back_end_compiles_its_lane_kernels_before_the_timed_runs(tiny, tmp
         if timed["on"] and len(self.module.run_lanes.signatures) > before:
             timed["compiled_while_timed"].append(self.ps[0].key.name)
 
-    real_warm = runner._warm
+    real_warm = runner.warm_runs
 
     def warm_then_time(*a, **k):
         out = real_warm(*a, **k)
@@ -157,7 +157,7 @@ def test_simd_back_end_compiles_its_lane_kernels_before_the_timed_runs(tiny, tmp
         return out
 
     monkeypatch.setattr(batch_mod._LaneGroup, "compile", watch)
-    monkeypatch.setattr(runner, "_warm", warm_then_time)
+    monkeypatch.setattr(runner, "warm_runs", warm_then_time)
     a = compare(tiny, controllers=["ftsmc"], out=tmp_path / "simd", progress=False, backend="simd")
     assert timed["on"] and timed["compiled_while_timed"] == []
     assert timed["timed"] and timed["timed"] <= timed["warm"]  # every lane kernel the runs used was set up in the warm-up
