@@ -38,13 +38,16 @@ QUICK_ITERATIONS, ITERATIONS = 8, 50
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help="Run the training rollouts on an existing Dask scheduler, tcp://host:port (probed first); "
                    "the workers must read the suite file. The numbers are those of a local training.")
-@click.option("--quiet", is_flag=True, help="No progress line.")
+@click.option("--quiet", is_flag=True, help="No progress line, no compile notice or bar.")
 def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, iterations: int | None,
           directions: int, top: int, step_size: float, noise: float, seeds_per_iteration: int, eval_every: int,
           substeps: int, duration: float | None, quick: bool, seed: int, method: str, action: str,
           scheduler: str | None, quiet: bool) -> None:
-    """Train a policy for a suite's tier by augmented random search or CMA-ES (no deep-learning stack); Ctrl-C keeps
-    every completed iteration, run again to resume.
+    """Train a policy for a suite's tier by augmented random search or CMA-ES (no deep-learning stack); Ctrl-C or
+    SIGTERM keeps every completed iteration, run again to resume.
+
+    The environments' compiled step is compiled (or loaded) before the first episode, with the
+    "compiling kernels (first run only, about N s)" notice and a progress bar on a first run.
     """
     from ..benchmark.suite import SuiteError
     from ..gym.train import TrainConfig
@@ -78,7 +81,8 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
             raise BadInput(str(exc)) from None
     with stop_once():
         try:
-            res = _train(cfg, out, progress=progress, client=client)
+            res = _train(cfg, out, progress=progress, client=client, compile_bar=not quiet,
+                         notify=(lambda text: None) if quiet else None)
         except (SuiteError, ValueError) as exc:
             raise BadInput(one_line(exc)) from None
         except KeyboardInterrupt:

@@ -24,7 +24,11 @@ drawn from the environment's generator): the same start, tier draws, disturbance
 """
 from __future__ import annotations
 
+import json
 import math
+import sys
+import time
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +45,7 @@ from ..simulation.pipeline import Prepared, prepare
 from ..user_modules import load_module
 from ..vehicle.presets import get_preset
 from .replay import GAINS
-from .stepping import COST_TERMS, Carry, new_carry, step_module
+from .stepping import COST_TERMS, PARALLEL_FROM, Carry, new_carry, step_module
 
 ACTIONS = {"tau": "auvtrack.gym.replay", "actuators": "auvtrack.gym.replay_actuators"}
 """Action modes -> the replay law that applies them."""
@@ -292,3 +296,88 @@ class TrackEnv(gym.Env):
         cause = int(c.cause[0])
         status = "ok" if cause == 0 else CAUSES.get(cause, ("controller", ""))[0]
         return {"metrics": metrics_finalize(c.acc[0].copy(), t0, min(t1, t)), "status": status, "t": t}
+
+
+def _example_step_arguments() -> tuple:
+    """Arguments of a step module's functions with the types every environment passes (C-contiguous, writeable)."""
+    f2, f3 = np.zeros((1, 1)), np.zeros((1, 1, 1))
+    ins = Stacked(f2, f2, f2, f2, f2, f3, f3, f3, f2, np.zeros((1, SI.size), np.int64), np.zeros((1, SF.size)))
+    return ins, new_carry(1, 1, 1, 1, OBS.size), OBS_BOUND
+
+
+def _step_marker(key, part: str) -> Path:
+    from ..jit import cache_dir
+
+    return cache_dir() / "kernels" / f"gym_{key.name}.{part}.json"
+
+
+def compile_steps(envs: Iterable, *, index: int = 0, progress: bool = False,
+                  notice: Callable[[str], None] | None = None) -> list[str]:
+    """Compile (or load) the compiled step of environments before their first episode.
+
+    The step functions of each (replay law, plant) pair (:func:`auvtrack.gym.stepping.step_module`)
+    compile on first use, about as long as a kernel; this compiles the ones ``envs`` call (a
+    vector environment of :data:`~auvtrack.gym.stepping.PARALLEL_FROM` envs or more also its
+    multithreaded step) with the "compiling kernels (first run only, about N s)" notice when any
+    is not cached yet.
+
+    Parameters
+    ----------
+    envs : iterable of TrackEnv or TrackVectorEnv
+        The environments.
+    index : int, optional
+        The seed index whose episode names the plant (a tier's ``cycle`` may vary it).
+    progress : bool, optional
+        A progress bar over the functions compiled.
+    notice : callable, optional
+        Receives the notice (default: printed to standard error).
+
+    Returns
+    -------
+    list of str
+        The functions compiled now, ``"<pair>: <function>"`` (empty when every one was cached).
+    """
+    import numba
+
+    from ..engine.kernels import compile_estimate
+
+    todo: dict[Any, list[str]] = {}
+    for env in envs:
+        one = getattr(env, "one", env)
+        parts = ["observe_all", "step_serial"] + (["step_all"] if getattr(env, "num_envs", 1) >= PARALLEL_FROM else [])
+        key = prepare(episode_scenario(one.suite, one.task, one.tier, index, action=one.action_mode,
+                                       substeps=one.substeps, duration=one.duration)).key
+        for part in parts:
+            if part not in todo.get(key, []) and not _step_marker(key, part).is_file():
+                todo.setdefault(key, []).append(part)
+    if not todo:
+        return []
+    say = notice or (lambda text: print(text, file=sys.stderr, flush=True))
+    heavy = sum(p != "observe_all" for parts in todo.values() for p in parts)
+    names = ", ".join(f"{key.label or key.name} environment step" for key in todo)
+    say(f"compiling kernels (first run only, about {compile_estimate() * max(heavy, 1):.0f} s): {names}")
+    total = sum(len(parts) for parts in todo.values())
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, desc="compiling", unit="kernel", leave=False)
+    sig = tuple(numba.typeof(a) for a in _example_step_arguments())
+    done = []
+    try:
+        for key, parts in todo.items():
+            module = step_module(key)
+            for part in parts:
+                t0 = time.perf_counter()
+                getattr(module, part).compile(sig)
+                marker = _step_marker(key, part)
+                marker.parent.mkdir(parents=True, exist_ok=True)
+                marker.write_text(json.dumps({"kernel": f"gym_{key.name}", "function": part,
+                                              "seconds": round(time.perf_counter() - t0, 2)}))
+                done.append(f"{key.label or key.name}: {part}")
+                if bar is not None:
+                    bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    return done

@@ -42,7 +42,7 @@ from .._atomic import atomic_file, atomic_write
 from ..benchmark.suite import Suite
 from ..control.policy import save_policy
 from ..control.policy_observation import OBS
-from .env import reward_weights, suite_of
+from .env import compile_steps, reward_weights, suite_of
 from .stepping import COST_TERMS
 from .vector import TrackVectorEnv
 
@@ -311,7 +311,7 @@ def _provenance(cfg: TrainConfig, suite: Suite, tier: str, tasks, res: TrainResu
 class _Trainer:
     """The state of one training: environments, policy, statistics, curve."""
 
-    def __init__(self, cfg: TrainConfig) -> None:
+    def __init__(self, cfg: TrainConfig, notify: Callable[[str], None] | None = None, bar: bool = False) -> None:
         cfg.check()
         suite = suite_of(cfg.suite)
         self.suite = suite.quick_variant() if cfg.quick else suite
@@ -340,6 +340,8 @@ class _Trainer:
         self.client = None  # a Dask client: the training rollouts run on its workers
         self.es = None  # CMA-ES: the strategy (made by start_cmaes)
         self.fitness: list[np.ndarray] = []  # CMA-ES: the values told per iteration (checkpointed)
+        compile_steps([*self.train_envs.values(), *self.val_envs.values()], index=self.train_seeds[0],
+                      progress=bar, notice=notify)  # before the first episode, with the notice
         first = self.train_envs[self.tasks[0]].one
         first.reset(seed=self.train_seeds[0])
         self.scale = np.asarray(first.scale, float)  # the action scale the policy file records
@@ -545,7 +547,7 @@ def command_line(cfg: TrainConfig) -> str:
 
 
 def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None] | None = None,
-          client=None) -> TrainResult:
+          client=None, notify: Callable[[str], None] | None = None, compile_bar: bool = False) -> TrainResult:
     """Train (or resume training) a linear policy; write the policy file, the curve and a checkpoint.
 
     Parameters
@@ -562,6 +564,11 @@ def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None]
         Run each iteration's training rollouts on its workers (one task per training task; each
         worker keeps its environments); the numbers are those of a local training.  The held-out
         evaluations run here.  The caller closes the client.
+    notify : callable, optional
+        Receives the "compiling kernels (first run only, about N s)" notice when the environments'
+        step is not cached yet (:func:`auvtrack.gym.env.compile_steps`; default standard error).
+    compile_bar : bool, optional
+        A progress bar over the functions compiled before the first episode.
 
     Returns
     -------
@@ -570,7 +577,7 @@ def train(cfg: TrainConfig, out: str | Path, *, progress: Callable[[dict], None]
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    trainer = _Trainer(cfg)
+    trainer = _Trainer(cfg, notify, compile_bar)
     trainer.client = client
     ckpt = out / CHECKPOINT
     if ckpt.is_file():
