@@ -18,20 +18,24 @@ __all__ = ["stop_once", "stop_requests"]
 
 
 @contextlib.contextmanager
-def stop_once() -> Iterator[None]:
+def stop_once() -> Iterator[Callable[[], bool]]:
     """Turn the first SIGINT or SIGTERM into ``KeyboardInterrupt`` and ignore the ones after it.
 
-    Outside the main thread (where Python delivers signals) nothing is changed.
+    Outside the main thread (where Python delivers signals) nothing is changed.  An exception
+    raised while Python runs a callback (a weak reference's, one of LLVM's while Numba compiles)
+    is dropped, so the ``KeyboardInterrupt`` can be lost: a command checks ``requested()`` between
+    its steps (trials, iterations) and stops there.
 
     Yields
     ------
-    None
-        The previous handlers are restored on exit, unless a signal stopped the command: the
+    callable
+        ``requested()``: True once a signal arrived (always False outside the main thread).  The
+        previous handlers are restored on exit, unless a signal stopped the command: the
         process is then ending (its clean-up at exit closes Dask's loops too), and both
         signals stay ignored until it exits.
     """
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield lambda: False
         return
     stopping = []
 
@@ -43,7 +47,7 @@ def stop_once() -> Iterator[None]:
 
     previous = {sig: signal.signal(sig, _stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        yield lambda: bool(stopping)
     finally:
         for sig, handler in previous.items():  # once stopping, the process is ending: stay deaf until it exits
             signal.signal(sig, signal.SIG_IGN if stopping else handler)

@@ -59,7 +59,11 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
                       seeds_per_iteration=seeds_per_iteration, eval_every=eval_every, substeps=substeps,
                       duration=duration, quick=quick, seed=seed, method=method, action=action)
 
+    stopped = None
+
     def progress(row: dict) -> None:
+        if stopped is not None and stopped():  # a signal whose KeyboardInterrupt was lost: stop here
+            raise KeyboardInterrupt
         if not quiet:
             val = row["validation_return"]
             click.echo(f"iteration {row['iteration']}/{cfg.iterations}: training return {row['train_return']:.6g}"
@@ -79,7 +83,7 @@ def train(suite_name: str, tier: str | None, tasks: tuple[str, ...], out: str, i
             client = connect_scheduler(scheduler)
         except SchedulerError as exc:
             raise BadInput(str(exc)) from None
-    with stop_once():
+    with stop_once() as stopped:
         try:
             res = _train(cfg, out, progress=progress, client=client, compile_bar=not quiet,
                          notify=(lambda text: None) if quiet else None)

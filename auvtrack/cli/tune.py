@@ -40,11 +40,15 @@ def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, 
     from ..benchmark.suite import SuiteError
     from ..tuning import tune as _tune
 
+    stopped = None
+
     def progress(done: int, total: int) -> None:
         if not quiet:
             click.echo(f"trial {done}/{total}", err=True)
+        if stopped is not None and stopped():  # a signal whose KeyboardInterrupt was lost: stop here
+            raise KeyboardInterrupt
 
-    with stop_once():
+    with stop_once() as stopped:
         try:
             res = _tune(controller, suite_name, trials=budget, out=out, sampler=sampler, seed=seed,
                         validate=not no_validate, workers=workers, backend=backend, parallel=parallel,

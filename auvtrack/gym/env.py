@@ -319,7 +319,8 @@ def compile_steps(envs: Iterable, *, index: int = 0, progress: bool = False,
     compile on first use, about as long as a kernel; this compiles the ones ``envs`` call (a
     vector environment of :data:`~auvtrack.gym.stepping.PARALLEL_FROM` envs or more also its
     multithreaded step) with the "compiling kernels (first run only, about N s)" notice when any
-    is not cached yet.
+    is not cached yet.  It runs in a thread (:func:`auvtrack.simulation.compiling.interruptible`):
+    Ctrl-C or SIGTERM stops the wait at once.
 
     Parameters
     ----------
@@ -337,6 +338,12 @@ def compile_steps(envs: Iterable, *, index: int = 0, progress: bool = False,
     list of str
         The functions compiled now, ``"<pair>: <function>"`` (empty when every one was cached).
     """
+    from ..simulation.compiling import interruptible
+
+    return interruptible(lambda: _compile_steps(list(envs), index, progress, notice))
+
+
+def _compile_steps(envs: list, index: int, progress: bool, notice: Callable[[str], None] | None) -> list[str]:
     import numba
 
     from ..engine.kernels import compile_estimate

@@ -5,13 +5,16 @@ functions name the pairs from the registries and hand them to the engine's compi
 """
 from __future__ import annotations
 
+import threading
 import time
-from typing import Callable, Sequence
+from typing import Callable, Sequence, TypeVar
 
 from ..engine import kernels
 
 __all__ = ["builtin_controllers", "builtin_pairs", "kernel_keys", "compile_first", "ensure_compiled",
-           "warmup", "lane_note"]
+           "interruptible", "warmup", "lane_note"]
+
+T = TypeVar("T")
 
 
 def builtin_controllers(plant: str = "5dof") -> tuple[str, ...]:
@@ -67,7 +70,47 @@ def ensure_compiled(preps: Sequence, *, progress: bool = False,
     notice : callable, optional
         Receives the notice (default: printed to standard error).
     """
-    kernels.warmup([p.key for p in preps], progress=progress, notice=notice)
+    keys = [p.key for p in preps]
+    if len({k for k in keys if not kernels.is_compiled(k)}) == 1 or kernels.usable_cores() == 1:
+        # compiled in this process (several compile in child processes, which a signal ends)
+        interruptible(lambda: kernels.warmup(keys, progress=progress, notice=notice))
+    else:
+        kernels.warmup(keys, progress=progress, notice=notice)
+
+
+def interruptible(fn: Callable[[], T]) -> T:
+    """Run ``fn`` (a compilation in this process) in a thread, so that Ctrl-C or SIGTERM stops the wait at once.
+
+    A signal handled while Numba compiles in the main thread can raise inside one of LLVM's ctypes
+    callbacks, where the exception is dropped and the library is left half compiled (the command
+    then fails with a ``RuntimeError`` instead of stopping).  Here the signal reaches the main
+    thread, which only waits: ``KeyboardInterrupt`` is raised at once and the compilation is
+    abandoned (the command line then ends the process with ``os._exit``,
+    :func:`auvtrack.interrupt.abandoned`).  Outside the main thread ``fn`` simply runs.
+
+    Parameters
+    ----------
+    fn : callable
+        The compilation.
+
+    Returns
+    -------
+    object
+        What ``fn`` returned.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        A signal came while waiting (even if ``fn`` finished meanwhile).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return fn()
+    from ..interrupt import run_in_thread
+
+    outcome = run_in_thread(fn)
+    if outcome.interrupted:
+        raise KeyboardInterrupt
+    return outcome.value
 
 
 def kernel_keys(pairs: Sequence[tuple[str, str]]) -> list[kernels.KernelKey]:
