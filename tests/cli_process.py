@@ -37,6 +37,10 @@ class CliProcess:
         if self.proc.poll() is None:  # a failed test: do not leave the command running
             self.proc.kill()
             self.proc.wait()
+        self._reader.join(HANG_S)
+        self._out_reader.join(HANG_S)
+        self.proc.stdout.close()
+        self.proc.stderr.close()
 
     def _read(self) -> None:
         for line in self.proc.stderr:

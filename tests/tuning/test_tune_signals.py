@@ -7,6 +7,7 @@ import sys
 
 import pytest
 
+from auvtrack.cli import main
 from auvtrack.tuning import study as study_mod
 from auvtrack.tuning import tune
 from cli_process import HANG_S, CliProcess, wait_gone
@@ -14,7 +15,7 @@ from tiny_suite import TINY
 
 from tuning_suite import SPLITS
 
-pytestmark = [pytest.mark.slow, pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")]
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX signals, reads /proc")
 
 
 @pytest.fixture(scope="module")
@@ -46,6 +47,7 @@ def _command(suite_path, out, budget, *extra):
             "--out", str(out), "--no-validate", *extra]
 
 
+@pytest.mark.slow
 def test_sigterm_keeps_the_study_and_the_same_command_resumes_it(suite_path, tmp_path):
     budget = 12
     tune("pid", suite_path, trials=budget, out=tmp_path / "whole", seed=7, validate=False)
@@ -68,6 +70,7 @@ def test_sigterm_keeps_the_study_and_the_same_command_resumes_it(suite_path, tmp
     assert not [t for t in _study(tmp_path / "cut").get_trials() if t.state.name == "RUNNING"]
 
 
+@pytest.mark.slow
 def test_sigterm_ends_the_worker_processes_of_parallel_trials(suite_path, tmp_path):
     budget = 40
     cmd = _command(suite_path, tmp_path / "par", budget, "--parallel", "2")
@@ -89,3 +92,33 @@ def test_sigterm_ends_the_worker_processes_of_parallel_trials(suite_path, tmp_pa
     assert len(_finished(tmp_path / "par")) == budget  # exactly the budget: nothing lost, nothing counted twice
     assert not [t for t in study.get_trials() if t.state.name == "RUNNING"]
     assert all(t in _finished(tmp_path / "par") for t in kept)
+
+
+class _LostSignal:
+    """Deleted, sends SIGTERM from its finaliser: the handler's KeyboardInterrupt is dropped there ("Exception ignored")."""
+
+    def __del__(self):
+        signal.raise_signal(signal.SIGTERM)
+
+
+def test_a_signal_whose_interrupt_was_dropped_stops_after_the_trial_under_way(suite_path, tmp_path, monkeypatch):
+    real, calls = study_mod._fly, []
+
+    def fly(*args, **kw):
+        calls.append(1)
+        if len(calls) == 2:
+            _LostSignal()
+        return real(*args, **kw)
+
+    monkeypatch.setattr(study_mod, "_fly", fly)
+    dropped = []
+    monkeypatch.setattr(sys, "unraisablehook", dropped.append)
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        code = main([*_command(suite_path, tmp_path / "lost", 5), "--quiet"])
+    finally:  # the command leaves both signals ignored (its process is ending): not this one
+        for s, handler in saved.items():
+            signal.signal(s, handler)
+    assert [type(u.exc_value) for u in dropped] == [KeyboardInterrupt]  # the signal's interrupt was lost
+    assert code == 130
+    assert len(_finished(tmp_path / "lost")) == 2 and len(calls) == 2
