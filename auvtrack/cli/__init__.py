@@ -7,8 +7,9 @@ plan, controller set-up), so it refuses the same scenarios with the same message
 that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
 prints the diagnostic and exits 3.  Ctrl-C stops a run within about a second, saves what was
 computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps its
-completed chunks for ``--resume`` and exits 130 (so does ``compare``).  ``auvtrack --help`` lists every command and
-these exit codes.
+completed chunks for ``--resume`` and exits 130 (so does ``compare``; ``tune`` keeps its study,
+``train`` its checkpoint).  Those four stop the same way on SIGTERM.  ``auvtrack --help`` lists
+every command and these exit codes.
 """
 from __future__ import annotations
 

@@ -101,8 +101,9 @@ EXIT_CODES = (("0", "success"),
               ("2", "bad input: one line naming the field and the allowed range, no traceback, nothing run"),
               ("3", "a simulation failed (diverged, pitch limit, envelope violated): the diagnostic is printed "
                     "and the partial result kept"),
-              ("130", "interrupted (Ctrl-C): a run keeps its partial result, a sweep or a comparison its "
-                      "completed chunks"))
+              ("130", "interrupted (Ctrl-C; SIGTERM too for sweep, compare, tune and train): a run keeps its partial "
+                      "result, a sweep or a comparison its completed chunks, a tuning its study, a training its "
+                      "completed iterations"))
 EXIT_CODES_HELP = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + "."
 COMMAND_ORDER = ("reproduce", "run", "check", "bounds", "scenarios", "study", "sweep", "compare", "bench", "warmup")
 
