@@ -71,7 +71,10 @@ def ensure_compiled(preps: Sequence, *, progress: bool = False,
         Receives the notice (default: printed to standard error).
     """
     keys = [p.key for p in preps]
-    if len({k for k in keys if not kernels.is_compiled(k)}) == 1 or kernels.usable_cores() == 1:
+    pending = {k for k in keys if not kernels.is_compiled(k)}
+    if not pending:
+        return
+    if len(pending) == 1 or kernels.usable_cores() == 1:
         # compiled in this process (several compile in child processes, which a signal ends)
         interruptible(lambda: kernels.warmup(keys, progress=progress, notice=notice))
     else:
