@@ -179,3 +179,47 @@ def test_check_env_every_cell_and_action_mode_of_auv_track_v2(task, tier, action
     """The checker on every task x tier of the shipped v2 suite, both action modes on the 6-DOF tiers (0.2 s episodes)."""
     env = TrackEnv("auv-track-v2", task, tier, action=action, duration=0.2)
     check_env(env, skip_render_check=True)
+
+
+def _benchmark_terms(suite: Suite, metrics: dict) -> dict[str, float]:
+    """The run score's capped terms of a completed run's metrics: the benchmark's derivation and scoring."""
+    import pandas as pd
+
+    from auvtrack.benchmark.leaderboard import derive_metrics
+    from auvtrack.benchmark.scoring import run_score_terms
+
+    rs = suite.file.run_score
+    row = derive_metrics(pd.DataFrame([{**metrics, "status": "ok"}]), criteria=tuple(rs.weights)).iloc[0]
+    return run_score_terms(row.to_dict(), rs.weights, rs.scales, cap=rs.cap)
+
+
+@pytest.mark.parametrize("tier, action, duration", [("design", "tau", 2.0), ("truth_fossen", "actuators", 4.0)])
+def test_return_charges_every_term_of_the_v2_run_score(tier, action, duration):
+    """The return == -sum_c w_c t_c^p (p = 2 for the RMS criteria, else 1), t_c the benchmark's run-score term."""
+    from auvtrack.gym.env import SQUARED
+
+    from auvtrack.gym.env import suite_of
+
+    suite = suite_of("auv-track-v2")
+    env = TrackEnv(suite, "helix", tier, action=action, duration=duration)
+    env.reset(seed=0)
+    rng = np.random.default_rng(7)
+    ret, done, k = 0.0, False, 0
+    while not done:  # the fins moved, then held at a limit (reached after the lag: 2 s on the 6-DOF plant)
+        a = np.array([0.8, 0.2 * rng.uniform(-1, 1) if k < 20 else 1.0, 0.2 * rng.uniform(-1, 1) if k < 20 else -1.0])
+        _, r, te, tr, info = env.step(a)
+        ret += r
+        done, k = te or tr, k + 1
+    assert info["status"] == "ok"
+    rs = suite.file.run_score
+    weighted = {c for c, w in rs.weights.items() if w > 0}
+    assert {"act_rate_q", "act_rate_r", "t_act_limit_q", "t_act_limit_r"} <= weighted
+    terms = _benchmark_terms(suite, info["metrics"])
+    assert set(terms) == weighted
+    cost = sum(rs.weights[c] * (t ** 2 if c in SQUARED else t) for c, t in terms.items())
+    assert ret == pytest.approx(-cost, rel=1e-9)
+    fins = [terms[c] for c in ("act_rate_q", "act_rate_r", "t_act_limit_q", "t_act_limit_r")]
+    if tier == "design":  # the 5-DOF plant without limits: no actuator position, the benchmark's terms are 0
+        assert fins == [0.0, 0.0, 0.0, 0.0]
+    else:
+        assert all(f > 0 for f in fins), fins
