@@ -866,7 +866,20 @@ def block_policy_compare(cv: dict, header: dict, digest: str) -> str:
                         f"{100 * p['failure_rate']:.1f} % {_pct_ci(*p['failure_ci'])} | {med} |")
     overall = ", ".join(f"`{c}` {lb[c]['score']:.2f} (rank {lb[c]['rank']:g}, 95 % interval "
                         f"[{lb[c]['rank_interval']['low']:g}, {lb[c]['rank_interval']['high']:g}])" for c in order)
-    tail = (f"Tier score: the suite's rank-based rule among these {len(order)} controllers (criteria "
+    mine = [c for c in cv["cells"] if c["controller"] == POLICY_LABEL]
+    others = [c for c in cv["cells"] if c["controller"] != POLICY_LABEL]
+    last = sum(lb[POLICY_LABEL]["tiers"][tier]["rank"] == len(order) for tier in tiers)
+    fails = sum(pooled[(tier, POLICY_LABEL)]["failures"] for tier in tiers)
+    runs = sum(pooled[(tier, POLICY_LABEL)]["n"] for tier in tiers)
+
+    def span(cs: list[dict]) -> str:
+        meds = [float(c["xtrack_rmse"]["median"]) if isinstance(c["xtrack_rmse"]["median"], (int, float)) else math.inf
+                for c in cs]
+        return f"{_f(min(meds))} to {_f(max(meds))} m"
+
+    verdict = (f"`{POLICY_LABEL}` ranks last of {len(order)} in {last} of {len(tiers)} tiers; {fails} of its {runs} runs "
+               f"failed; its cell medians of `xtrack_rmse` span {span(mine)}, the other controllers' {span(others)}.")
+    tail = (verdict + "\n\n" + f"Tier score: the suite's rank-based rule among these {len(order)} controllers (criteria "
             f"{', '.join(cv['criteria'])}), the mean of its cell scores over the tasks, lower is better (rank 1 the "
             f"best); a median is over all {s['seeds']} seeds of a cell, a failed run counting as `inf`. Overall: {overall}.")
     return head + "\n\n" + "\n".join(rows) + "\n\n" + tail

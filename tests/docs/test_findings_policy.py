@@ -88,3 +88,16 @@ def test_the_block_states_the_conditions(stored):
     assert f"version {stored['suite']['version']}" in text and f"{stored['suite']['seeds']} evaluation seeds" in text
     assert f"back end {stored['timing']['batch_backend']}" in text
     assert f"{pv['config']['duration']:g} s on the {pv['tier']} tier" in text and pv["command"] in text
+
+
+def test_the_verdict_line_reads_the_result(stored):
+    """The policy's summary: tiers where it ranks last, its failures, the spans of the cell medians."""
+    text = _render(stored)
+    tiers = [t for t in stored["suite"]["file"]["tiers"] if t not in stored["suite"]["skipped_tiers"]]
+    pol = next(r for r in stored["leaderboard"] if r["controller"] == "policy")
+    last = sum(pol["tiers"][t]["rank"] == len(stored["controllers"]) for t in tiers)
+    fails = sum(r["failures"] for r in stored["pooled_tier"] if r["controller"] == "policy")
+    assert f"ranks last of {len(stored['controllers'])} in {last} of {len(tiers)} tiers; {fails} of its" in text
+    worse = copy.deepcopy(stored)
+    next(r for r in worse["pooled_tier"] if r["controller"] == "policy")["failures"] += 3
+    assert f"{fails + 3} of its" in _render(worse)
