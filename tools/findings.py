@@ -35,7 +35,7 @@ from auvtrack.report import fmt
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "docs" / "results"
-DOCS = {"findings": ROOT / "docs" / "findings.md", "readme": ROOT / "README.md"}
+DOCS = {"findings": ROOT / "docs" / "findings.md", "readme": ROOT / "README.md", "gym": ROOT / "docs" / "gym.md"}
 
 SOURCES: dict[str, str] = {
     "reproduce": "auvtrack reproduce --out reproduce  (reproduce/metrics.json)",
@@ -47,8 +47,16 @@ SOURCES: dict[str, str] = {
     "realism": "auvtrack study realism --out studies/realism  (results.json)",
     "model-gap": "auvtrack study model-gap --out studies/model-gap  (results.json)",
     "compare-v2": "auvtrack compare --suite auv-track-v2 --backend simd --out compare/auv-track-v2  (results.json)",
+    "compare-v2-policy": "auvtrack compare --suite auv-track-v2 --controllers pid,los_autopilot,policy --backend simd "
+                         "--out compare/auv-track-v2-policy  (results.json)",
 }
 """Stored result name -> the command whose output it is."""
+
+KEEP: dict[str, tuple[str, ...]] = {
+    "compare-v2-policy": ("suite", "controllers", "auvtrack_version", "source_hash", "criteria", "weights",
+                          "leaderboard", "not_tuned_on_suite", "cells", "pooled_tier", "pooled", "timing"),
+}
+"""Stored result name -> the keys of the command's output it keeps (the rest: the whole output)."""
 
 AXES = ("x", "y", "z")
 INPUTS = ("u", "q", "r")
@@ -60,6 +68,8 @@ WORD = {1: "larger", 0: "equal", -1: "smaller"}
 def store(name: str, path: str | Path) -> Path:
     """Copy the result file ``path`` of source ``name`` to ``docs/results/<name>.json`` (compact, with provenance).
 
+    Only the keys :data:`KEEP` names are kept for a source listed there.
+
     Raises
     ------
     KeyError
@@ -70,6 +80,8 @@ def store(name: str, path: str | Path) -> Path:
     from auvtrack.jit import source_hash
 
     data = json.loads(Path(path).read_text())
+    if name in KEEP:
+        data = {k: data[k] for k in KEEP[name] if k in data}
     data["_provenance"] = {"command": SOURCES[name],
                            "stored": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                            "source_hash": source_hash()[:16]}
@@ -789,6 +801,90 @@ def block_readme_compare_v2(cv: dict) -> str:
             f"{s['name']}`.")
 
 
+POLICY_LABEL = "policy"
+"""The learned law's label in the policy comparison."""
+
+
+def _median_text(cell: dict, metric: str) -> str:
+    """A cell's median of ``metric`` as a table entry (``inf`` when more than half its runs failed)."""
+    m = cell[metric]["median"]
+    return "inf" if m is None or (isinstance(m, (int, float)) and math.isinf(m)) or m == "inf" else _f(float(m))
+
+
+def shipped_policy_digest() -> str:
+    """SHA-256 of the shipped policy file ``controller.kind = "policy"`` flies by default."""
+    import hashlib
+
+    from auvtrack.control.policy import DEFAULT_POLICY, policy_path
+
+    return hashlib.sha256(policy_path(DEFAULT_POLICY).read_bytes()).hexdigest()
+
+
+def block_policy_compare(cv: dict, header: dict, digest: str) -> str:
+    """docs/gym.md: the shipped policy next to the classical controllers on auv-track-v2, per tier.
+
+    ``cv`` is the stored comparison; ``header`` and ``digest`` (SHA-256) are those of the policy file
+    whose training the block describes.
+
+    Raises
+    ------
+    ValueError
+        The comparison flew another policy file than ``digest`` (re-run its command and store it).
+    """
+    s, t = cv["suite"], cv["timing"]
+    pv = header["provenance"]
+    cfg, budget = pv["config"], pv["budget"]
+    entry = next(c for c in cv["controllers"] if c["label"] == POLICY_LABEL)
+    if entry["digest"] != digest:
+        raise ValueError(f"compare-v2-policy: the stored comparison flew the policy file sha256 {entry['digest'][:16]}, "
+                         f"not {digest[:16]}: run `{SOURCES['compare-v2-policy']}` and store it")
+    tasks = list(s["durations"])
+    tiers = [tr for tr in s["file"]["tiers"] if tr not in s["skipped_tiers"]]
+    order = [r["controller"] for r in cv["leaderboard"]]
+    lb = {r["controller"]: r for r in cv["leaderboard"]}
+    pooled = {(r["tier"], r["controller"]): r for r in cv["pooled_tier"]}
+    cells = {(c["tier"], c["task"], c["controller"]): c for c in cv["cells"]}
+    seen = {pv["tier"]}
+    head = (f"`{cv['_provenance']['command']}`, stored {cv['_provenance']['stored']} (sources "
+            f"{cv['source_hash'][:12]}): suite {s['name']} version {s['version']}, {s['seeds']} evaluation seeds per "
+            f"cell (seed indices 0 to {s['seeds'] - 1}, none flown in training), {t['runs']} runs, back end "
+            f"{t['batch_backend']}. The policy: `{POLICY_LABEL}` = {entry['gains']}, trained by `{pv['command']}`: "
+            f"{pv['method'].split(' (')[0]}, {budget['iterations']} iterations, {budget['episodes']} episodes of "
+            f"{cfg['duration']:g} s on the {pv['tier']} tier ({', '.join(pv['tasks'])}; training seeds "
+            f"{pv['training_seeds'][0]} to {pv['training_seeds'][1] - 1}, validation seeds {pv['validation_seeds'][0]} "
+            f"to {pv['validation_seeds'][1] - 1}), {budget['env_steps']} environment steps. Every tier but "
+            f"{', '.join(sorted(seen))} and every episode longer than {cfg['duration']:g} s are unseen in training.")
+    rows = ["| tier | in training | controller | tier score (rank) | failure rate [Wilson 95 %] | median `xtrack_rmse` (m): "
+            + " / ".join(tasks) + " |", "|---|---|---|---|---|---|"]
+    for tier in tiers:
+        for c in order:
+            p = pooled[(tier, c)]
+            sc = lb[c]["tiers"][tier]
+            med = " / ".join(_median_text(cells[(tier, task, c)], "xtrack_rmse") for task in tasks)
+            seen_txt = ("yes" if tier in seen else "no") if c == POLICY_LABEL else ""
+            rows.append(f"| {tier} | {seen_txt} | `{c}` | {sc['score']:.2f} ({sc['rank']:g}) | "
+                        f"{100 * p['failure_rate']:.1f} % {_pct_ci(*p['failure_ci'])} | {med} |")
+    overall = ", ".join(f"`{c}` {lb[c]['score']:.2f} (rank {lb[c]['rank']:g}, 95 % interval "
+                        f"[{lb[c]['rank_interval']['low']:g}, {lb[c]['rank_interval']['high']:g}])" for c in order)
+    mine = [c for c in cv["cells"] if c["controller"] == POLICY_LABEL]
+    others = [c for c in cv["cells"] if c["controller"] != POLICY_LABEL]
+    last = sum(lb[POLICY_LABEL]["tiers"][tier]["rank"] == len(order) for tier in tiers)
+    fails = sum(pooled[(tier, POLICY_LABEL)]["failures"] for tier in tiers)
+    runs = sum(pooled[(tier, POLICY_LABEL)]["n"] for tier in tiers)
+
+    def span(cs: list[dict]) -> str:
+        meds = [float(c["xtrack_rmse"]["median"]) if isinstance(c["xtrack_rmse"]["median"], (int, float)) else math.inf
+                for c in cs]
+        return f"{_f(min(meds))} to {_f(max(meds))} m"
+
+    verdict = (f"`{POLICY_LABEL}` ranks last of {len(order)} in {last} of {len(tiers)} tiers; {fails} of its {runs} runs "
+               f"failed; its cell medians of `xtrack_rmse` span {span(mine)}, the other controllers' {span(others)}.")
+    tail = (verdict + "\n\n" + f"Tier score: the suite's rank-based rule among these {len(order)} controllers (criteria "
+            f"{', '.join(cv['criteria'])}), the mean of its cell scores over the tasks, lower is better (rank 1 the "
+            f"best); a median is over all {s['seeds']} seeds of a cell, a failed run counting as `inf`. Overall: {overall}.")
+    return head + "\n\n" + "\n".join(rows) + "\n\n" + tail
+
+
 # ------------------------------------------------------------------ rendering
 def blocks() -> dict[str, tuple[str, Callable[[], str]]]:
     """Generated block name -> (document key, renderer)."""
@@ -810,7 +906,16 @@ def blocks() -> dict[str, tuple[str, Callable[[], str]]]:
                                                                load("fixed-time"), load("realism"),
                                                                load("model-gap"))),
         "readme-benchmark": ("readme", lambda: block_readme_compare_v2(load("compare-v2"))),
+        "policy-compare": ("gym", lambda: block_policy_compare(load("compare-v2-policy"), _policy_header(),
+                                                               shipped_policy_digest())),
     }
+
+
+def _policy_header() -> dict:
+    """The header of the shipped default policy (its training's provenance)."""
+    from auvtrack.control.policy import DEFAULT_POLICY, load_policy
+
+    return load_policy(DEFAULT_POLICY)["header"]
 
 
 BLOCK_RE = re.compile(r"(<!-- BEGIN GENERATED (?P<name>[\w-]+)[^>]*-->\n)(?P<body>.*?)(<!-- END GENERATED (?P=name) -->)",

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
-__all__ = ["run_score", "failure_floor"]
+__all__ = ["run_score", "run_score_terms", "failure_floor"]
 
 
 def failure_floor(cap: float) -> float:
@@ -64,6 +64,40 @@ def run_score(values: Mapping[str, Any], weights: Mapping[str, float], scales: M
         frac = min(max(t_stop / duration, 0.0), 1.0) if math.isfinite(t_stop) else 0.0
         return failure_floor(cap) + (1.0 - frac)
     score = 0.0
+    for c, term in run_score_terms(values, weights, scales, cap=cap).items():
+        score += weights[c] * term
+    return min(score / total, cap)  # the weighted mean of capped terms, rounding kept inside the cap
+
+
+def run_score_terms(values: Mapping[str, Any], weights: Mapping[str, float], scales: Mapping[str, float], *,
+                    cap: float) -> dict[str, float]:
+    """The capped term of each weighted criterion of a completed run: min(m_c / s_c, cap), in [0, cap].
+
+    :func:`run_score` of a completed run is the weighted mean of these terms; a criterion that is
+    NaN or infinite scores the cap.
+
+    Parameters
+    ----------
+    values : mapping
+        The run's value of each criterion of ``weights`` by name.
+    weights : mapping of str to float
+        Criterion -> weight; the criteria with a weight > 0 get a term.
+    scales : mapping of str to float
+        Criterion -> the value that scores 1.
+    cap : float
+        Largest term.
+
+    Returns
+    -------
+    dict of str to float
+        Criterion -> term, in the order of ``weights``.
+
+    Raises
+    ------
+    ValueError
+        A weighted criterion without a scale.
+    """
+    terms: dict[str, float] = {}
     for c, w in weights.items():
         if w <= 0:
             continue
@@ -71,5 +105,5 @@ def run_score(values: Mapping[str, Any], weights: Mapping[str, float], scales: M
             raise ValueError(f"run_score: scales.{c}: missing (the value of {c} that scores 1)")
         m = float(values[c])
         term = min(m / scales[c], cap) if math.isfinite(m) else cap
-        score += w * max(term, 0.0)
-    return min(score / total, cap)  # the weighted mean of capped terms, rounding kept inside the cap
+        terms[c] = max(term, 0.0)
+    return terms

@@ -384,7 +384,8 @@ class ControllerEntry:
     gains : str
         Where its gains come from, for the report.
     digest : str
-        SHA-256 of a plug-in file (empty for built-ins): part of the comparison's fingerprint.
+        SHA-256 of a plug-in file or of the policy file a learned law flies (empty for the other
+        built-ins): part of the comparison's fingerprint.
     """
 
     label: str
@@ -455,7 +456,23 @@ def _builtin_entry(kind: str, pattern: str) -> ControllerEntry:
     if preset in available_gain_presets() and get_gain_preset(preset).kind == kind:
         desc = get_gain_preset(preset).description
         return ControllerEntry(kind, {"kind": kind, "preset": preset}, f"preset {preset}: {desc}")
+    policy = _default_policy_file(kind)
+    if policy is not None:
+        digest = hashlib.sha256(policy.read_bytes()).hexdigest()
+        return ControllerEntry(kind, {"kind": kind}, f"policy file {policy.name} (sha256 {digest[:16]})", digest)
     return ControllerEntry(kind, {"kind": kind}, f"package defaults (no gain preset {preset!r} is installed)")
+
+
+def _default_policy_file(kind: str) -> Path | None:
+    """The file a learned law (a controller with a ``file`` parameter) flies by default, if it exists."""
+    from ..control import CONTROLLERS
+    from ..control.policy import policy_path
+
+    field = CONTROLLERS[kind].params.model_fields.get("file")
+    if field is None or not isinstance(field.default, str):
+        return None
+    path = policy_path(field.default)
+    return path if path.is_file() else None
 
 
 def _plugin_entry(path: str | Path, taken: set[str]) -> ControllerEntry:

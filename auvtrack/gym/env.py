@@ -14,11 +14,13 @@ drawn from the environment's generator): the same start, tier draws, disturbance
 * **Observations**: :mod:`auvtrack.control.policy_observation` (the function the ``policy`` law
   uses), a Box with its clip bounds.
 * **Reward**: minus the increment over the step of the episode's cost, built from the benchmark's
-  metric sums and the suite's ``[run_score]`` (weights w, scales s, cap): w_rmse min((rmse/s_rmse)^2,
-  cap^2) on the integral of |e|^2 over the task's duration T, w_energy min(E/s_energy, cap) on the
-  integral of |tau|^2, w_tv min(TV/s_tv, cap) on tau's total variation
-  (:func:`~auvtrack.gym.stepping.episode_cost`); a failure costs one more than the sum of the three
-  caps, so a failed episode returns less than any completed one.  ``terminated``: the engine's failure causes;
+  metric sums and the suite's ``[run_score]`` (weights w, scales s, cap): every criterion c the run
+  score weighs costs w_c t_c^2 when it is an RMS metric (:data:`SQUARED`: the squares are sums over
+  time) and w_c t_c otherwise, with t_c = min(m_c / s_c, cap) the run score's term
+  (:func:`~auvtrack.benchmark.scoring.run_score_terms`) and m_c the benchmark's metric of the episode
+  so far with the means taken over the episode's duration T (:func:`~auvtrack.gym.stepping.episode_cost`):
+  at the end of a completed episode m_c is the run's metric.  A failure costs one more than the sum of
+  the caps, so a failed episode returns less than any completed one.  ``terminated``: the engine's failure causes;
   ``truncated``: the task's duration reached.  ``info["metrics"]`` at the end: the run's benchmark
   metrics (:func:`auvtrack.metrics.metrics_finalize`), ``info["status"]``, ``info["seed_index"]``.
 """
@@ -128,15 +130,18 @@ def action_scale(prep: Prepared, action: str) -> np.ndarray:
     return out
 
 
-SCORE_METRIC = {"error": "rmse", "energy": "energy", "tv": "tv", "xtrack": "xtrack_rmse", "vtrack": "vtrack_rmse",
-                "along": "along_rmse"}
-"""The suite ``[run_score]`` metric whose weight and scale each cost term takes (:data:`~auvtrack.gym.stepping.COST_TERMS`)."""
-MEAN_SQUARE = ("error", "xtrack", "vtrack", "along")
-"""Cost terms that are an RMS metric: charged as w min((rms/s)^2, cap^2), rms^2 = the sum over the task's duration."""
+SQUARED = ("rmse", "xtrack_rmse", "vtrack_rmse", "along_rmse")
+"""Cost terms that are an RMS metric m: charged as w min((m/s)^2, cap^2) = w t^2 (t the run score's term), m^2 =
+the accumulated sum over the episode's duration T, so that the cost grows with the time integral of the error."""
+PER_SECOND = ("tv", "act_rate_u", "act_rate_q", "act_rate_r")
+"""Cost terms whose metric is a total variation per second: the accumulated variation over T."""
 
 
 def reward_weights(suite: Suite) -> tuple[tuple[float, ...], tuple[float, ...], float]:
     """The reward's weights, caps and failure penalty from the suite's ``[run_score]`` (module docstring).
+
+    Every criterion the run score weighs is a cost term (:data:`~auvtrack.gym.stepping.COST_TERMS`,
+    named by the criterion) with the run score's weight w, scale s and cap.
 
     Parameters
     ----------
@@ -146,18 +151,27 @@ def reward_weights(suite: Suite) -> tuple[tuple[float, ...], tuple[float, ...], 
     Returns
     -------
     (tuple, tuple, float)
-        Per cost term: k = w / s^2 (RMS terms, still to be divided by the duration) or w / s; the cap
-        w cap^2 (RMS terms) or w cap; and the penalty, one more than the sum of the caps.  A suite
-        without a run score charges the virtual point's error alone (w = s = 1).
+        Per cost term: k = w / s^2 (:data:`SQUARED`) or w / s, still to be divided by the duration for
+        the :data:`SQUARED` and :data:`PER_SECOND` terms; the cap w cap^2 (:data:`SQUARED`) or w cap;
+        and the penalty, one more than the sum of the caps.  A suite without a run score charges the
+        virtual point's error alone (w = s = 1).
+
+    Raises
+    ------
+    ValueError
+        The run score weighs a criterion that is not a cost term.
     """
     rs = suite.file.run_score
     if not any(w > 0 for w in rs.weights.values()):
         rs = rs.model_copy(update={"weights": {"rmse": 1.0}, "scales": {"rmse": 1.0}})
+    missing = [c for c, w in rs.weights.items() if w > 0 and c not in COST_TERMS]
+    if missing:
+        raise ValueError(f"run_score.weights: {', '.join(missing)}: not a reward term of the environment "
+                         f"(those are {', '.join(COST_TERMS)})")
     k, caps = [], []
     for term in COST_TERMS:
-        metric = SCORE_METRIC[term]
-        w, s = rs.weights.get(metric, 0.0), rs.scales.get(metric, 1.0)
-        square = term in MEAN_SQUARE
+        w, s = rs.weights.get(term, 0.0), rs.scales.get(term, 1.0)
+        square = term in SQUARED
         k.append(w / s ** 2 if square else w / s)
         caps.append(w * rs.cap ** 2 if square else w * rs.cap)
     return tuple(k), tuple(caps), 1.0 + sum(caps)
@@ -218,7 +232,7 @@ class TrackEnv(gym.Env):
         self.carry.xc[0] = prep.controller.x0
         duration = float(prep.scenario.sim.duration)
         k, caps, penalty = self._weights
-        self.carry.rw[0] = (*(v / duration if term in MEAN_SQUARE else v for term, v in zip(COST_TERMS, k)),
+        self.carry.rw[0] = (*(v / duration if term in SQUARED + PER_SECOND else v for term, v in zip(COST_TERMS, k)),
                             *caps, penalty)
         self.kernels = step_module(prep.key)
         self.kernels.observe_all(self.ins, self.carry, OBS_BOUND)

@@ -22,7 +22,10 @@ from ..engine.loop import (  # the engine's parts this step is built of (rebound
     CAUSE_CONTROLLER, CAUSE_NONE, SF, SI, Buffers, LawOutputs, Loop, Settings, advance, attitude, first_stage,
     Rk4, measure, plant, prange, sample, state_free_disturbance, take_step,
 )
-from ..metrics import METRICS_SIZE, OFF_E2, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2, metrics_init
+from ..metrics import (
+    METRICS_SIZE, OFF_ACT_LIMIT, OFF_ACT_TV, OFF_E2, OFF_EMAX, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2,
+    PATH_XTMAX, metrics_init,
+)
 from ..plant.contract import SCRATCH_SIZE
 
 __all__ = ["Carry", "new_carry", "step_module", "episode_cost", "COST_TERMS", "REWARD", "PENALTY", "PARALLEL_FROM"]
@@ -30,8 +33,10 @@ __all__ = ["Carry", "new_carry", "step_module", "episode_cost", "COST_TERMS", "R
 PARALLEL_FROM = 256
 """Envs from which a step runs in the thread pool (``step_all``) rather than in one thread (``step_serial``)."""
 
-COST_TERMS = ("error", "energy", "tv", "xtrack", "vtrack", "along")
-"""The episode cost's terms (:func:`episode_cost`), in the order of their weights and caps in ``Carry.rw``."""
+COST_TERMS = ("rmse", "energy", "tv", "xtrack_rmse", "vtrack_rmse", "along_rmse", "max_error", "xtrack_max",
+              "act_rate_u", "act_rate_q", "act_rate_r", "t_act_limit_u", "t_act_limit_q", "t_act_limit_r")
+"""The episode cost's terms (:func:`episode_cost`), named by the suite ``[run_score]`` criterion each charges,
+in the order of their weights and caps in ``Carry.rw``."""
 N_COST = len(COST_TERMS)
 REWARD = tuple(f"k_{n}" for n in COST_TERMS) + tuple(f"cap_{n}" for n in COST_TERMS) + ("penalty",)
 """Reward terms per env (row of ``Carry.rw``): see :func:`episode_cost`."""
@@ -142,20 +147,27 @@ def episode_cost(rw, acc):
 
     S are the metrics accumulator's sums (:mod:`auvtrack.metrics`), in the order of
     :data:`COST_TERMS`: of squared virtual-point error times dt (m^2 s), of squared tau times dt,
-    tau's total variation, and the path-following sums at the navigation point over the window: squared
-    cross-track, vertical-track and along-track error times dt (m^2 s; zero with ``metrics.path = false``).
-    ``rw`` = (k_1 .. k_6, cap_1 .. cap_6, penalty) (:data:`REWARD`).  Capped, so that a completed episode
-    costs at most the sum of the caps (the failure penalty is more).
+    tau's total variation, the path-following sums at the navigation point over the window (squared
+    cross-track, vertical-track and along-track error times dt, m^2 s; zero with ``metrics.path = false``),
+    the largest |e_a| and the largest cross-track distance so far, each actuator's total variation
+    (fractions of its limit) and its time at the limit (s).  ``rw`` = (k_1 .. k_n, cap_1 .. cap_n, penalty)
+    (:data:`REWARD`).  Capped, so that a completed episode costs at most the sum of the caps (the failure
+    penalty is more).
     """
-    s_e, s_n, s_v = 0.0, 0.0, 0.0
+    s_e, s_n, s_v, m_e = 0.0, 0.0, 0.0, 0.0
     for j in range(3):
         s_e += acc[OFF_E2 + j]
         s_n += acc[OFF_TEN + j]
         s_v += acc[OFF_TV + j]
+        m_e = max(m_e, acc[OFF_EMAX + j])
+    sums = (s_e, s_n, s_v, acc[OFF_PATH + PATH_XT2], acc[OFF_PATH + PATH_VT2], acc[OFF_PATH + PATH_AL2], m_e,
+            acc[OFF_PATH + PATH_XTMAX], acc[OFF_ACT_TV], acc[OFF_ACT_TV + 1], acc[OFF_ACT_TV + 2], acc[OFF_ACT_LIMIT],
+            acc[OFF_ACT_LIMIT + 1], acc[OFF_ACT_LIMIT + 2])
     n = N_COST
-    return (min(rw[0] * s_e, rw[n]) + min(rw[1] * s_n, rw[n + 1]) + min(rw[2] * s_v, rw[n + 2])
-            + min(rw[3] * acc[OFF_PATH + PATH_XT2], rw[n + 3]) + min(rw[4] * acc[OFF_PATH + PATH_VT2], rw[n + 4])
-            + min(rw[5] * acc[OFF_PATH + PATH_AL2], rw[n + 5]))
+    cost = 0.0
+    for j in range(n):
+        cost += min(rw[j] * sums[j], rw[n + j])
+    return cost
 
 
 def env_observe(ins, c, i, bound):
@@ -206,7 +218,8 @@ from numba import prange  # noqa: F401
 from auvtrack.engine.kernels import KernelKey, kernel_module
 from auvtrack.jit import njit  # noqa: F401
 from auvtrack.control.policy_observation import observe  # noqa: F401
-from auvtrack.metrics import OFF_E2, OFF_PATH, OFF_TEN, OFF_TV, PATH_AL2, PATH_VT2, PATH_XT2  # noqa: F401
+from auvtrack.metrics import OFF_ACT_LIMIT, OFF_ACT_TV, OFF_E2, OFF_EMAX, OFF_PATH, OFF_TEN, OFF_TV  # noqa: F401
+from auvtrack.metrics import PATH_AL2, PATH_VT2, PATH_XT2, PATH_XTMAX  # noqa: F401
 from auvtrack.gym.stepping import N_COST, PENALTY  # noqa: F401
 _k = kernel_module(KernelKey({key.law!r}, {key.plant!r}, {key.label!r}))
 globals().update({{n: getattr(_k, n) for n in dir(_k) if not n.startswith("__")}})

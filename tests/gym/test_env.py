@@ -116,7 +116,7 @@ def test_return_is_the_capped_benchmark_cost():
         dur = info["t"] - env.prep.scenario.metrics.window[0]
         ms2 = sum(m[f"rmse_{a}"] ** 2 for a in "xyz") * dur / 1.0  # integral of |e|^2 over T = 1 s
         energy = sum(v for k, v in m.items() if k.startswith("energy_tau_"))
-        tv = sum(v for k, v in m.items() if k.startswith("tv_tau_")) * dur
+        tv = sum(v for k, v in m.items() if k.startswith("tv_tau_")) * dur / 1.0  # per second over T = 1 s
         cost = min(ms2 / 0.04 ** 2, 9.0) + 0.5 * min(energy / 20.0, 3.0) + 0.25 * min(tv / 50.0, 3.0)
         assert ret == pytest.approx(-cost, rel=1e-9)
         capped.append((ms2 / 0.04 ** 2 > 9.0, energy / 20.0 > 3.0, tv / 50.0 > 3.0))
@@ -179,3 +179,79 @@ def test_check_env_every_cell_and_action_mode_of_auv_track_v2(task, tier, action
     """The checker on every task x tier of the shipped v2 suite, both action modes on the 6-DOF tiers (0.2 s episodes)."""
     env = TrackEnv("auv-track-v2", task, tier, action=action, duration=0.2)
     check_env(env, skip_render_check=True)
+
+
+def _benchmark_terms(suite: Suite, metrics: dict) -> dict[str, float]:
+    """The run score's capped terms of a completed run's metrics: the benchmark's derivation and scoring."""
+    import pandas as pd
+
+    from auvtrack.benchmark.leaderboard import derive_metrics
+    from auvtrack.benchmark.scoring import run_score_terms
+
+    rs = suite.file.run_score
+    row = derive_metrics(pd.DataFrame([{**metrics, "status": "ok"}]), criteria=tuple(rs.weights)).iloc[0]
+    return run_score_terms(row.to_dict(), rs.weights, rs.scales, cap=rs.cap)
+
+
+@pytest.mark.parametrize("tier, action, duration", [("design", "tau", 2.0), ("truth_fossen", "actuators", 4.0)])
+def test_return_charges_every_term_of_the_v2_run_score(tier, action, duration):
+    """The return == -sum_c w_c t_c^p (p = 2 for the RMS criteria, else 1), t_c the benchmark's run-score term."""
+    from auvtrack.gym.env import SQUARED
+
+    from auvtrack.gym.env import suite_of
+
+    suite = suite_of("auv-track-v2")
+    env = TrackEnv(suite, "helix", tier, action=action, duration=duration)
+    env.reset(seed=0)
+    rng = np.random.default_rng(7)
+    ret, done, k = 0.0, False, 0
+    while not done:  # the fins moved, then held at a limit (reached after the lag: 2 s on the 6-DOF plant)
+        a = np.array([0.8, 0.2 * rng.uniform(-1, 1) if k < 20 else 1.0, 0.2 * rng.uniform(-1, 1) if k < 20 else -1.0])
+        _, r, te, tr, info = env.step(a)
+        ret += r
+        done, k = te or tr, k + 1
+    assert info["status"] == "ok"
+    rs = suite.file.run_score
+    weighted = {c for c, w in rs.weights.items() if w > 0}
+    assert {"act_rate_q", "act_rate_r", "t_act_limit_q", "t_act_limit_r"} <= weighted
+    terms = _benchmark_terms(suite, info["metrics"])
+    assert set(terms) == weighted
+    cost = sum(rs.weights[c] * (t ** 2 if c in SQUARED else t) for c, t in terms.items())
+    assert ret == pytest.approx(-cost, rel=1e-9)
+    fins = [terms[c] for c in ("act_rate_q", "act_rate_r", "t_act_limit_q", "t_act_limit_r")]
+    if tier == "design":  # the 5-DOF plant without limits: no actuator position, the benchmark's terms are 0
+        assert fins == [0.0, 0.0, 0.0, 0.0]
+    else:
+        assert all(f > 0 for f in fins), fins
+
+
+PEAKS = Suite(SuiteFile.model_validate(tomllib.loads(
+    TINY + "\n[run_score]\ncap = 3.0\n[run_score.weights]\nrmse = 0.5\ntv = 0.25\nmax_error = 1.0\nxtrack_max = 0.5\n"
+    "[run_score.scales]\nrmse = 0.2\ntv = 100.0\nmax_error = 0.5\nxtrack_max = 0.4\n")), "tiny-peaks")
+
+
+def test_return_charges_the_peak_terms_and_tv_per_second():
+    """max_error and xtrack_max as the run score's terms; tv per second over T = 2 s (the benchmark's tv)."""
+    from auvtrack.gym.env import SQUARED
+
+    env = TrackEnv(PEAKS, "helix", "model", duration=2.0)
+    env.reset(seed=0)
+    rng = np.random.default_rng(11)
+    ret, done = 0.0, False
+    while not done:
+        _, r, te, tr, info = env.step(0.5 * rng.uniform(-1, 1, 3))
+        ret += r
+        done = te or tr
+    assert info["status"] == "ok"
+    terms = _benchmark_terms(PEAKS, info["metrics"])
+    assert set(terms) == {"rmse", "tv", "max_error", "xtrack_max"} and all(0 < t < 3.0 for t in terms.values())
+    w = PEAKS.file.run_score.weights
+    assert ret == pytest.approx(-sum(w[c] * (t ** 2 if c in SQUARED else t) for c, t in terms.items()), rel=1e-9)
+
+
+def test_a_run_score_weighing_a_criterion_the_reward_cannot_charge_is_refused():
+    itae = Suite(SuiteFile.model_validate(tomllib.loads(
+        TINY + "\n[run_score]\n[run_score.weights]\nrmse = 1.0\nitae = 0.5\n[run_score.scales]\nrmse = 1.0\nitae = 10.0\n")),
+        "tiny-itae")
+    with pytest.raises(ValueError, match="itae"):
+        TrackEnv(itae, "helix", "calm", duration=0.4)

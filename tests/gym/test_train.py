@@ -88,7 +88,7 @@ def test_seeds_come_from_the_splits(tmp_path, suite_file, monkeypatch):
     assert prov["training_seeds"] == [100, 108] and prov["validation_seeds"] == [200, 204]
     assert prov["budget"]["episodes"] == res.episodes == 4 * 2 * 2 * 2
     assert prov["command"].startswith("auvtrack train --suite") and "ARS" in prov["method"]
-    assert prov["reward"] == {"error": [1.0, 100.0]}  # no run score: the error alone, w = s = 1, cap 10 squared
+    assert prov["reward"] == {"rmse": [1.0, 100.0]}  # no run score: the error alone, w = s = 1, cap 10 squared
 
 
 def test_quick_improves_the_held_out_return(tmp_path, suite_file, capsys):
