@@ -10,6 +10,10 @@
   median (the LOS autopilot, the vehicle-level baseline) when it is a competitor with a finite,
   positive median in every cell; otherwise the metric's ``[run_score]`` scale (one value for
   every cell); with neither, no aggregate (the reason is recorded);
+* **cap** of the median and mean of task means: the suite's ``[run_score]`` cap (10 in v2): a
+  normalised score enters a task mean as ``min(r, cap)``, and a failed run as ``cap``, so these
+  two averages stay finite when runs fail; the failure rate of each controller is recorded next
+  to them (``failure_rate``);
 * **intervals**: the stratified bootstrap with strata = tasks (the tiers of a task share their
   seeds), one set of draws for every controller (paired), the suite's confidence and bootstrap
   size, generators ``SeedSequence([seed, crc32("aggregates/<statistic>")])``.
@@ -110,7 +114,8 @@ def aggregate_analysis(df, suite, controllers: Sequence[str]) -> dict[str, Any]:
     -------
     dict
         ``score``, ``normalisation`` (the rule), ``scales`` (``{"task/tier": divisor}``),
-        ``strata``, ``n_resamples``, ``confidence``, ``estimates`` (``{aggregate: {controller:
+        ``strata``, ``n_resamples``, ``confidence``, ``cap`` (of the median and mean of task
+        means), ``failure_rate`` (``{controller: failed runs / runs}``), ``estimates`` (``{aggregate: {controller:
         {"point", "low", "high"}}}``), ``profiles`` (``{controller: {"taus", "fraction", "low",
         "high"}}``) and ``improvement`` (``[{"x", "y", "point", "low", "high"}]``, every ordered
         pair); without a normalisation only ``score``, ``normalisation`` and ``estimates = None``.
@@ -126,13 +131,16 @@ def aggregate_analysis(df, suite, controllers: Sequence[str]) -> dict[str, Any]:
     runs["norm"] = ag.normalise(df, score, scales, cells=CELLS).to_numpy()
     sm = ag.score_matrices(runs, "norm", cells=CELLS, strata=STRATA, controllers=list(controllers))
     n, level = suite.bootstrap_resamples, f.confidence
-    est = ag.aggregate_estimates(sm, _rng(f.seed, "aggregates/estimates"), n_resamples=n, confidence=level)
+    cap = float(f.run_score.cap)
+    est = ag.aggregate_estimates(sm, _rng(f.seed, "aggregates/estimates"), cap=cap, n_resamples=n,
+                                 confidence=level)
+    failed = {c: float((runs.loc[runs["controller"] == c, "status"] != "ok").mean()) for c in sm.scores}
     taus = profile_taus(runs["norm"].to_numpy(dtype=float))
     prof = ag.performance_profiles(sm, taus, _rng(f.seed, "aggregates/profiles"), n_resamples=n, confidence=level)
     poi = ag.improvement_probabilities(sm, _rng(f.seed, "aggregates/improvement"), n_resamples=n, confidence=level)
     return out | {
         "scales": {f"{k[0]}/{k[1]}": v for k, v in scales.items()}, "strata": list(STRATA), "n_resamples": n,
-        "confidence": level, "estimates": est.to_dict(),
+        "confidence": level, "cap": cap, "failure_rate": failed, "estimates": est.to_dict(),
         "profiles": {c: p.to_dict() for c, p in prof.items()},
         "improvement": [{"x": x, "y": y, **e.to_dict()} for (x, y), e in poi.items()],
     }
