@@ -741,8 +741,8 @@ def block_compare_v2(cv: dict) -> str:
     agg = cv.get("aggregates") or {}
     iqm = (agg.get("estimates") or {}).get("iqm", {})
     mean = (agg.get("estimates") or {}).get("mean", {})
-    cap = agg.get("cap")
-    capped = f" (capped at {cap:g})" if cap is not None else ""
+    rule = agg.get("cap_rule")
+    capped = " (capped)" if rule else ""
     pooled = {r["controller"]: r for r in cv["pooled"]}
     rows = ["| rank | controller | score | rank 95 % CI | failure rate [Wilson 95 %] | IQM of normalised `"
             f"{agg.get('score', '?')}` [95 %] | mean of task means{capped} [95 %] | gains |",
@@ -773,9 +773,8 @@ def block_compare_v2(cv: dict) -> str:
             f"Normalisation of the aggregates: {agg.get('normalisation', 'none')}; IQM with "
             f"{agg.get('n_resamples', '?')} stratified-bootstrap replicates (strata: {', '.join(agg.get('strata', []))}); "
             "not finite when more than a quarter of a controller's runs failed (a failed run is `inf`)"
-            + (f"; the mean of the (task, tier) cells' mean normalised `{agg.get('score', '?')}` counts a failed run, "
-               f"and a ratio above {cap:g}, as {cap:g} (docs/benchmark.md), so read it with the failure rate."
-               if cap is not None else "."))
+            + (f"; in the mean of the (task, tier) cells' mean normalised `{agg.get('score', '?')}`, {rule} "
+               "(docs/benchmark.md): read it with the failure rate." if rule else "."))
     tail = [_untuned_text(cv), "",
             f"{fails} runs failed, {unknown} of them without a recorded cause"
             + (" (by cause: " + ", ".join(f"{k} {v}" for k, v in sorted(by_cause.items())) + ")" if by_cause else "")

@@ -145,30 +145,30 @@ def iqm(scores: Any) -> np.ndarray | float:
     return float(out) if np.ndim(out) == 0 else np.asarray(out, dtype=float)
 
 
-def _check_cap(cap: float | None) -> float | None:
+def _check_cap(cap: Any) -> float | np.ndarray | None:
     if cap is None:
         return None
-    c = float(cap)
-    if not (math.isfinite(c) and c > 0.0):
-        raise ValueError(f"cap: must be finite and > 0, or None (got {cap})")
-    return c
+    c = np.array(cap, dtype=float)
+    if c.ndim > 1 or c.size == 0 or not np.all(np.isfinite(c) & (c > 0.0)):
+        raise ValueError(f"cap: must be finite and > 0 (one number, or one per task), or None (got {cap})")
+    return float(c) if c.ndim == 0 else c
 
 
-def capped(scores: Any, cap: float | None) -> np.ndarray:
-    """Scores with every value above ``cap`` (a failure's ``inf`` too) set to ``cap``.
+def capped(scores: Any, cap: Any) -> np.ndarray:
+    """Scores with every value above the cap (a failure's ``inf`` too) set to the cap.
 
     The task means of :func:`aggregate_median` and :func:`aggregate_mean` use capped scores when
-    a cap is given: a failed run then counts as the cap, a finite score that no completed run
-    of a useful controller reaches, instead of ``inf``, which would make every mean it enters
-    ``inf`` and hide everything else about the controller.
+    a cap is given: a failed run then counts as the cap, a large finite score, instead of
+    ``inf``, which would make every mean it enters ``inf`` and hide everything else about the
+    controller.
 
     Parameters
     ----------
     scores : array_like
-        Scores (lower is better); ``nan`` counts as ``+inf``.
-    cap : float or None
-        Finite and > 0 (in the scores' unit: for normalised scores, a multiple of the
-        reference), or None for no cap.
+        Scores shaped ``(..., tasks)`` (lower is better); ``nan`` counts as ``+inf``.
+    cap : float, sequence of float or None
+        Finite and > 0 (in the scores' unit): one number, or one per task (the last axis), or
+        None for no cap.
 
     Returns
     -------
@@ -177,24 +177,28 @@ def capped(scores: Any, cap: float | None) -> np.ndarray:
     """
     x = _scores(scores)
     c = _check_cap(cap)
-    return x if c is None else np.minimum(x, c)
+    if c is None:
+        return x
+    if np.ndim(c) == 1 and c.shape[0] != x.shape[-1]:
+        raise ValueError(f"cap: need one per task ({x.shape[-1]}), got {c.shape[0]}")
+    return np.minimum(x, c)
 
 
-def aggregate_median(scores: Any, cap: float | None = None) -> np.ndarray | float:
+def aggregate_median(scores: Any, cap: Any = None) -> np.ndarray | float:
     """Median over the tasks of the per-task mean score (rliable's ``aggregate_median``).
 
     Without a cap, one failed run makes its task's mean ``inf``, and the median is ``inf`` once
     more than half the tasks hold a failure (for an even number of tasks, once the upper middle
     one does).  With a cap, each score enters its task mean as ``min(s, cap)`` (:func:`capped`):
-    a failure counts as ``cap`` and the median is finite, at most ``cap``.
+    a failure counts as the cap and the median is finite.
 
     Parameters
     ----------
     scores : array_like
         Shape ``(..., runs, tasks)``; ``nan`` counts as ``+inf``.
-    cap : float or None, optional
-        Finite and > 0: the value of a failure and the largest value of a completed run (None:
-        rliable's uncapped statistic).
+    cap : float, sequence of float or None, optional
+        Finite and > 0, one number or one per task: the value of a failure and the largest value
+        of a completed run (None: rliable's uncapped statistic).
 
     Returns
     -------
@@ -206,21 +210,21 @@ def aggregate_median(scores: Any, cap: float | None = None) -> np.ndarray | floa
     return float(out) if np.ndim(out) == 0 else out
 
 
-def aggregate_mean(scores: Any, cap: float | None = None) -> np.ndarray | float:
+def aggregate_mean(scores: Any, cap: Any = None) -> np.ndarray | float:
     """Mean over the tasks of the per-task mean score (rliable's ``aggregate_mean``).
 
     Without a cap, one failed run anywhere makes it ``inf``.  With a cap, each score enters its
-    task mean as ``min(s, cap)`` (:func:`capped`): a failure counts as ``cap``, so the mean is
-    finite, at most ``cap``, and a failure rate f adds at most ``f cap`` to it (per task); the
-    benchmark states the failure rate next to it.
+    task mean as ``min(s, cap)`` (:func:`capped`): a failure counts as the cap, so the mean is
+    finite, and a failure rate f in a task adds at most f times that task's cap to its mean;
+    the benchmark states the failure rate next to it.
 
     Parameters
     ----------
     scores : array_like
         Shape ``(..., runs, tasks)``; ``nan`` counts as ``+inf``.
-    cap : float or None, optional
-        Finite and > 0: the value of a failure and the largest value of a completed run (None:
-        rliable's uncapped statistic).
+    cap : float, sequence of float or None, optional
+        Finite and > 0, one number or one per task: the value of a failure and the largest value
+        of a completed run (None: rliable's uncapped statistic).
 
     Returns
     -------
@@ -770,7 +774,7 @@ class AggregateEstimates:
 def aggregate_estimates(data, rng: np.random.Generator, *, score: str | None = None,
                         cells: Sequence[str] = ("task", "tier"), strata: Sequence | None = None,
                         aggregates: Sequence[str] = tuple(AGGREGATES), gamma: float = 1.0,
-                        cap: float | None = None, n_resamples: int = 2000,
+                        cap: Any = None, n_resamples: int = 2000,
                         confidence: float = 0.95) -> AggregateEstimates:
     """IQM, median, mean and optimality gap of every controller with stratified-bootstrap intervals.
 
@@ -796,9 +800,10 @@ def aggregate_estimates(data, rng: np.random.Generator, *, score: str | None = N
         Names among :data:`AGGREGATES`.
     gamma : float, optional
         Target error of the optimality gap.
-    cap : float or None, optional
-        Cap of the median and mean of task means (:data:`CAPPED`, :func:`capped`): a failure
-        counts as ``cap`` there; None (default): rliable's uncapped statistics.
+    cap : float, sequence of float or None, optional
+        Cap of the median and mean of task means (:data:`CAPPED`, :func:`capped`), one number or
+        one per column: a failure counts as the cap there; None (default): rliable's uncapped
+        statistics.
     n_resamples : int, optional
         Bootstrap replicates.
     confidence : float, optional

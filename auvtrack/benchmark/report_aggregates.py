@@ -44,10 +44,10 @@ def write_aggregates_section(rep: Any, agg: Mapping[str, Any], order: Sequence[s
         return
     level = float(agg["confidence"])
     pct = f"{100 * level:g} %"
-    cap = agg.get("cap")
-    means = (f"the median and mean of the per-cell means of min(r, {cap:g}) (a failed run counts as {cap:g}, "
-             f"{cap:g} times the reference's typical error, so one failure does not make them `inf`; the "
-             "failure rate stands next to them)" if cap is not None else "the median and mean of the per-cell means")
+    capped = agg.get("cap_rule")
+    means = (f"the median and mean of the per-cell means of capped scores ({capped}; so one failure does not "
+             "make them `inf`, and the failure rate stands next to them)" if capped
+             else "the median and mean of the per-cell means")
     rep.paragraph(f"After Agarwal et al. (2021, `rliable`): the interquartile mean (IQM) of every normalised run "
                   f"(finite while at most a quarter of a controller's runs fail), {means}, and the optimality gap "
                   f"at 1 (the mean of max(0, 1 - 1/r)); {pct} stratified-"
@@ -57,8 +57,7 @@ def write_aggregates_section(rep: Any, agg: Mapping[str, Any], order: Sequence[s
     est = agg["estimates"]
     aggs = list(est)
     rates = agg.get("failure_rate")
-    titles = {a: f"{AGGREGATE_LABELS.get(a, a)}{f' (capped at {cap:g})' if cap is not None and a in CAPPED else ''}"
-              for a in aggs}
+    titles = {a: f"{AGGREGATE_LABELS.get(a, a)}{' (capped)' if capped and a in CAPPED else ''}" for a in aggs}
     rep.table(["controller"] + [f"{titles[a]} [{pct}]" for a in aggs] + (["failure rate"] if rates else []),
               [[c] + [_interval(est[a][c]) for a in aggs] + ([f"{100 * rates[c]:.1f} %"] if rates else [])
                for c in order])

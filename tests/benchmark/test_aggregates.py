@@ -66,9 +66,14 @@ def test_capped_median_and_mean_by_hand():
     assert ag.aggregate_mean(x, cap=0.5) == 0.5               # every score at or above the cap
     assert ag.aggregate_mean([[np.nan]], cap=4.0) == 4.0      # nan is a failure
     assert ag.capped(x, None)[1, 1] == INF and ag.capped(x, 10.0).max() == 10.0
-    for bad in (0.0, -1.0, INF, np.nan):
+    # one cap per task: 4, 10, 2 -> task means (0.5 + 1 + 1.5) / 3 = 1, 22/3, (1 + 2 + 2) / 3 = 5/3
+    assert ag.aggregate_mean(x, cap=[4.0, 10.0, 2.0]) == pytest.approx((1.0 + 22.0 / 3.0 + 5.0 / 3.0) / 3.0, rel=1e-15)
+    assert ag.aggregate_median(x, cap=[4.0, 10.0, 2.0]) == pytest.approx(5.0 / 3.0, rel=1e-15)
+    for bad in (0.0, -1.0, INF, np.nan, [1.0, 0.0, 1.0], [[1.0]]):
         with pytest.raises(ValueError, match="cap: must be finite and > 0"):
             ag.aggregate_mean(x, cap=bad)
+    with pytest.raises(ValueError, match=r"cap: need one per task \(3\), got 2"):
+        ag.aggregate_mean(x, cap=[1.0, 2.0])
 
 
 def test_capped_estimates_cap_the_means_only():

@@ -1,0 +1,319 @@
+"""Why the auv-track-v2 PID preset misses the helix on Fossen's truth: the runs, stored, and the doc block.
+
+The tuned PID of auv-track-v2 (``pid_remus100_auv-track-v2``) has a median ``xtrack_rmse`` above
+the acceptance's 0.5 m on the ``truth_fossen`` / ``helix`` cell, while the older preset
+``pid_tuned`` stays below it.  This tool flies the PID with a few gain sets on the runs that
+decide it, exactly as ``auvtrack compare`` and ``auvtrack tune`` build them
+(:meth:`auvtrack.benchmark.suite.Suite.scenario`, :func:`auvtrack.benchmark.execute.run_chunk`,
+the suite's run score):
+
+* the training split (every cell, the seeds ``auvtrack tune`` scores: its objective is the mean
+  run score over these runs);
+* the ``helix`` / ``truth_fossen`` cell on the training seeds and on the evaluation seeds;
+* the ``digital`` tier on the evaluation seeds (where the PID's candidates fail).
+
+Commands::
+
+    python -m tools.pid_preset_gap run      # fly the runs, write docs/results/pid-preset-gap.json
+    python -m tools.pid_preset_gap render   # rewrite the generated block of docs/tuning.md
+    python -m tools.pid_preset_gap check    # exit status 1 when the block differs from the stored result
+
+``tests/docs/test_pid_preset_gap.py`` runs ``check`` and ties the stored shipped-preset cell to
+the stored comparison (``docs/results/compare-v2.json``).  Importing this module runs nothing.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+import re
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULT = ROOT / "docs" / "results" / "pid-preset-gap.json"
+DOC = ROOT / "docs" / "tuning.md"
+NAME = "pid-preset-gap"
+BLOCK_RE = re.compile(rf"(<!-- BEGIN GENERATED {NAME}[^>]*-->\n)(.*?)(<!-- END GENERATED {NAME} -->)", re.S)
+SUITE = "auv-track-v2"
+SHIPPED = "pid_remus100_auv-track-v2"
+OLD = "pid_tuned"
+CELL = ("helix", "truth_fossen")
+DIGITAL = "digital"
+BACKEND = "simd"
+XTRACK_TARGET = 0.5  # m, the acceptance's bound on a calm truth cell's median cross-track error
+KP_STEPS = (1.0, 1.5)
+"""Proportional gains flown with the shipped preset's other gains (besides the old preset's kp)."""
+COLUMNS = ("xtrack_rmse", "xtrack_rmse_late", "vtrack_rmse", "energy", "tv", "act_rate_q", "act_rate_r",
+           "t_act_limit_q", "t_act_limit_r")
+GAINS = ("kp", "ki", "kd", "kaw", "saturation")
+
+
+def variants() -> dict[str, tuple[dict[str, Any], str]]:
+    """Label -> (the ``[controller]`` table flown, what it is).
+
+    The shipped preset, the old one, the designed gains (the tuning's first trial) and the
+    shipped preset with one gain changed: its kp raised (to :data:`KP_STEPS` and to the old
+    preset's kp), or its ki set to the designed ki (integral action).
+    """
+    from auvtrack.control.gain_presets import get_gain_preset
+
+    shipped = dict(get_gain_preset(SHIPPED).gains)
+    old_kp = float(get_gain_preset(OLD).gains["kp"])
+    designed_ki = float(_resolved({"kind": "pid"})["ki"])
+    out: dict[str, tuple[dict[str, Any], str]] = {
+        "shipped": ({"kind": "pid", "preset": SHIPPED}, f"`{SHIPPED}`, the shipped preset (TPE, 20 trials)"),
+        "old": ({"kind": "pid", "preset": OLD}, f"`{OLD}`, differential evolution on the paper's vehicle (docs below)"),
+        "designed": ({"kind": "pid"}, "the designed gains (the tuning's trial 0, the untuned PID)"),
+    }
+    for kp in (*KP_STEPS, old_kp):
+        out[f"shipped, kp {kp:.4g}"] = ({"kind": "pid", **shipped, "kp": kp}, f"the shipped preset with kp = {kp:.4g}")
+    out["shipped, designed ki"] = ({"kind": "pid", **shipped, "ki": designed_ki},
+                                   f"the shipped preset with the designed ki = {designed_ki:.3g}")
+    return out
+
+
+def _suite():
+    from auvtrack.benchmark.suite import load_suite
+
+    return load_suite(SUITE, check=False)
+
+
+def _resolved(table: dict[str, Any]) -> dict[str, Any]:
+    """The gains a ``[controller]`` table resolves to on the first training run of the cell."""
+    from auvtrack.benchmark.execute import RunSpec, _prepare
+    from auvtrack.benchmark.suite import ControllerEntry
+
+    suite = _suite()
+    raw, ov, drawn = suite.scenario(ControllerEntry("x", dict(table), "x"), *CELL, suite.split_seeds("training")[0])
+    prep = _prepare(RunSpec(0, "x", *CELL, 0, raw, ov, drawn))
+    if isinstance(prep, str):
+        raise ValueError(f"{table}: refused at set-up: {prep}")
+    ctl = prep.scenario.controller.model_dump()
+    return {k: ctl[k] for k in GAINS}
+
+
+def _fly(suite, table: dict[str, Any], cells: list[tuple[str, str]], seeds: range):
+    """The runs of ``cells`` x ``seeds`` for one controller table, with derived metrics and run scores."""
+    from auvtrack.benchmark.execute import RunSpec, run_chunk
+    from auvtrack.benchmark.leaderboard import derive_metrics
+    from auvtrack.benchmark.suite import ControllerEntry
+
+    entry = ControllerEntry("pid", dict(table), "flown by tools.pid_preset_gap")
+    specs = []
+    for task, tier in cells:
+        for i in seeds:
+            raw, ov, drawn = suite.scenario(entry, task, tier, i)
+            specs.append(RunSpec(len(specs), "pid", task, tier, i, raw, ov, drawn))
+    df = derive_metrics(run_chunk(specs, workers=None, backend=BACKEND).to_pandas(), settle=suite.file.metrics.settle)
+    df["score"] = [suite.run_score(r, r["task"]) for r in df.to_dict("records")]
+    return df
+
+
+def _terms(suite, df) -> dict[str, float]:
+    """Mean share of each weighted criterion in the run score of the completed runs (they add up to its mean)."""
+    rs = suite.file.run_score
+    total = sum(w for w in rs.weights.values() if w > 0)
+    ok = df[df["status"] == "ok"]
+    out = {}
+    for c, w in rs.weights.items():
+        if w > 0:
+            v = ok[c].to_numpy(dtype=float) / rs.scales[c]
+            v[~(v < rs.cap)] = rs.cap
+            out[c] = float((w * v).mean() / total) if len(ok) else math.nan
+    return out
+
+
+def _summary(suite, df) -> dict[str, Any]:
+    """Failures (by cause), medians and maxima of :data:`COLUMNS`, mean run score and its terms."""
+    ok = df[df["status"] == "ok"]
+    failed = df[df["status"] != "ok"]
+    causes: dict[str, int] = {}
+    for (task, tier, cause), n in failed.groupby(["task", "tier", "cause"]).size().items():
+        causes[f"{task}/{tier}/{cause or 'unknown'}"] = int(n)
+    return {"runs": len(df), "failures": len(failed), "failures_by_cell_cause": causes,
+            "score_mean": float(df["score"].mean()),
+            "median": {c: float(ok[c].median()) if len(ok) else math.nan for c in COLUMNS},
+            "max": {c: float(ok[c].max()) if len(ok) else math.nan for c in COLUMNS},
+            "score_terms": _terms(suite, df)}
+
+
+def run(out: Path = RESULT) -> Path:
+    """Fly every variant on the runs of the module docstring and write the summary to ``out``.
+
+    Parameters
+    ----------
+    out : pathlib.Path, optional
+        The JSON file written (default ``docs/results/pid-preset-gap.json``).
+
+    Returns
+    -------
+    pathlib.Path
+        ``out``.
+    """
+    from auvtrack.control.gain_presets import get_gain_preset
+    from auvtrack.jit import source_hash
+
+    suite = _suite()
+    training, evaluation = suite.split_seeds("training"), suite.split_seeds("evaluation")
+    t0 = time.perf_counter()
+    result: dict[str, Any] = {"suite": {"name": suite.name, "version": suite.file.version,
+                                        "training_seeds": [training.start, training.stop],
+                                        "evaluation_seeds": [evaluation.start, evaluation.stop],
+                                        "training_cells": [list(c) for c in suite.split_cells("training")],
+                                        "run_score": suite.file.run_score.model_dump(mode="json")},
+                              "cell": list(CELL), "backend": BACKEND, "variants": {},
+                              "shipped_tuning": {k: get_gain_preset(SHIPPED).provenance.get(k) for k in
+                                                 ("budget_trials", "complete", "pruned", "refused", "sampler",
+                                                  "train_score")}}
+    for label, (table, what) in variants().items():
+        train = _fly(suite, table, suite.split_cells("training"), training)
+        cell_eval = _fly(suite, table, [CELL], evaluation)
+        digital = _fly(suite, table, [(t, DIGITAL) for t in suite.tasks], evaluation)
+        cell_train = train[(train["task"] == CELL[0]) & (train["tier"] == CELL[1])]
+        result["variants"][label] = {
+            "table": table, "what": what, "gains": _resolved(table),
+            "training": _summary(suite, train), "cell_training": _summary(suite, cell_train),
+            "cell_evaluation": _summary(suite, cell_eval), "digital_evaluation": _summary(suite, digital)}
+        print(f"{label}: training score {result['variants'][label]['training']['score_mean']:.4f}", file=sys.stderr)
+    result["_provenance"] = {"command": "python -m tools.pid_preset_gap run",
+                             "stored": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+                             "source_hash": source_hash()[:16], "seconds": round(time.perf_counter() - t0, 1)}
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(result, indent=1, allow_nan=False) + "\n")
+    return out
+
+
+# ------------------------------------------------------------------ the doc block
+def _g(x: float, d: int = 3) -> str:
+    return f"{x:.{d}g}"
+
+
+def _fails(s: dict[str, Any]) -> str:
+    if not s["failures"]:
+        return "0"
+    causes: dict[str, int] = {}
+    for key, n in s["failures_by_cell_cause"].items():
+        causes[key.rsplit("/", 1)[1]] = causes.get(key.rsplit("/", 1)[1], 0) + n
+    return f"{s['failures']} ({', '.join(f'{k} {v}' for k, v in sorted(causes.items()))})"
+
+
+def block(res: dict[str, Any]) -> str:
+    """The generated block of docs/tuning.md from a stored result of :func:`run`.
+
+    Parameters
+    ----------
+    res : dict
+        The stored JSON.
+
+    Returns
+    -------
+    str
+        Markdown: provenance, the table of every variant and the reading of it.
+    """
+    v = res["variants"]
+    s, task, tier = res["suite"], *res["cell"]
+    n_train = v["shipped"]["training"]["runs"]
+    n_cell_t, n_cell_e = v["shipped"]["cell_training"]["runs"], v["shipped"]["cell_evaluation"]["runs"]
+    n_dig = v["shipped"]["digital_evaluation"]["runs"]
+    head = (f"`{res['_provenance']['command']}`, stored {res['_provenance']['stored']} (sources "
+            f"{res['_provenance']['source_hash'][:12]}, {res['backend']} back end): {s['name']} v{s['version']}; "
+            f"training split: {len(s['training_cells'])} cells x seeds {s['training_seeds'][0]}-"
+            f"{s['training_seeds'][1] - 1} ({n_train} runs, the runs `auvtrack tune` scores); the `{task}` / "
+            f"`{tier}` cell on those seeds ({n_cell_t} runs) and on the evaluation seeds "
+            f"{s['evaluation_seeds'][0]}-{s['evaluation_seeds'][1] - 1} ({n_cell_e} runs, those of `auvtrack compare`); "
+            f"the `{DIGITAL}` tier on the evaluation seeds ({n_dig} runs).")
+    rows = ["| gains | kp | ki | kd | kaw | training objective (mean run score) | training runs failed | "
+            f"{task}/{tier} median `xtrack_rmse` (m), training / evaluation seeds | late `xtrack_rmse` (m), "
+            "evaluation | median energy (N² s) | time at a fin limit, max (s) q / r | mean run score of the cell, "
+            f"evaluation | {DIGITAL} tier, evaluation runs failed |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for label, r in v.items():
+        g, ce = r["gains"], r["cell_evaluation"]
+        rows.append(f"| {r['what']} | {_g(g['kp'], 4)} | {_g(g['ki'], 3)} | {_g(g['kd'], 4)} | {_g(g['kaw'], 3)} | "
+                    f"{r['training']['score_mean']:.3f} | {_fails(r['training'])} | "
+                    f"{_g(r['cell_training']['median']['xtrack_rmse'])} / {_g(ce['median']['xtrack_rmse'])} | "
+                    f"{_g(ce['median']['xtrack_rmse_late'])} | {ce['median']['energy']:.0f} | "
+                    f"{_g(ce['max']['t_act_limit_q'])} / {_g(ce['max']['t_act_limit_r'])} | "
+                    f"{ce['score_mean']:.3f} | {_fails(r['digital_evaluation'])} |")
+    sh, old, des, tu = v["shipped"], v["old"], v["designed"], res["shipped_tuning"]
+    terms = sh["cell_evaluation"]["score_terms"]
+    xt = terms["xtrack_rmse"]
+    effort = sum(terms[c] for c in terms if c not in ("xtrack_rmse", "vtrack_rmse", "along_rmse", "rmse"))
+    completing = [r for r in v.values() if r["training"]["failures"] == 0]
+    best_kp = max(r["gains"]["kp"] for r in completing)
+    ratio = [r["cell_evaluation"]["median"]["xtrack_rmse"] * r["gains"]["kp"]
+             for r in v.values() if r["table"].get("preset") != OLD and r["gains"]["ki"] == sh["gains"]["ki"]]
+    text = [
+        f"* **Not the seeds.** The shipped preset's median on the cell is {_g(sh['cell_training']['median']['xtrack_rmse'])} m "
+        f"on the training seeds and {_g(sh['cell_evaluation']['median']['xtrack_rmse'])} m on the evaluation seeds: "
+        "it is as far off on the seeds it was tuned on.",
+        f"* **Not the actuators, not the effort terms.** On the cell no gain set spends time at a fin limit "
+        f"(largest: {_g(max(r['cell_evaluation']['max']['t_act_limit_q'] for r in v.values()))} s stern planes, "
+        f"{_g(max(r['cell_evaluation']['max']['t_act_limit_r'] for r in v.values()))} s rudder), and the shipped "
+        f"preset uses no less energy than the old one ({sh['cell_evaluation']['median']['energy']:.0f} against "
+        f"{old['cell_evaluation']['median']['energy']:.0f} N² s): it buys nothing with its error. Of its mean run "
+        f"score on the cell ({sh['cell_evaluation']['score_mean']:.3f}) the cross-track term is {xt:.3f} and energy, "
+        f"input variation and fin use together {effort:.3f}. The old preset scores better on the cell "
+        f"({old['cell_evaluation']['score_mean']:.3f}), and the designed gains better still "
+        f"({des['cell_evaluation']['score_mean']:.3f}).",
+        f"* **The gains: a steady offset that scales as 1/kp.** The late-window error "
+        f"({_g(sh['cell_evaluation']['median']['xtrack_rmse_late'])} m) is about the whole run's: the vehicle "
+        f"settles beside the helix. The shipped preset has kp = {_g(sh['gains']['kp'], 3)} and practically no "
+        f"integral action (ki = {_g(sh['gains']['ki'], 2)}); with its other gains, median `xtrack_rmse` x kp stays "
+        f"within [{_g(min(ratio))}, {_g(max(ratio))}] m/s² as kp goes from {_g(sh['gains']['kp'], 3)} to "
+        f"{_g(max(r['gains']['kp'] for r in v.values()), 4)}: the offset is a constant model-mismatch "
+        f"acceleration of the 6-DOF truth held by a proportional term. The designed ki removes most of it "
+        f"({_g(v['shipped, designed ki']['cell_evaluation']['median']['xtrack_rmse'])} m at the shipped kp).",
+        f"* **Why the tuning kept a small kp: the failure-first objective and the digital tier.** Every gain set "
+        f"that is stiffer than the shipped one fails runs of the `{DIGITAL}` tier (sampled control, sensor noise, "
+        "saturated and rate-limited actuators: docs/benchmark.md) by the pitch limit, on the training seeds and on the evaluation seeds alike; a "
+        f"failed run scores at least cap + 1 = {res['suite']['run_score']['cap'] + 1:g}, and `auvtrack tune` "
+        "prunes a candidate at its first failed run. Of the gain sets here, only "
+        + ", ".join(f"{r['what']}" for r in completing)
+        + f" complete{'s' if len(completing) == 1 else ''} the training split (largest kp {_g(best_kp, 4)}), so its "
+        f"objective ({sh['training']['score_mean']:.3f}) is lower than the old preset's "
+        f"({old['training']['score_mean']:.3f}) and the designed gains' ({des['training']['score_mean']:.3f}), "
+        "although both track the helix on Fossen's truth better. With "
+        f"{tu['budget_trials']} trials, of which {tu['complete']} completed ({tu['pruned']} pruned at a failed run, "
+        f"{tu['refused']} refused at set-up; the preset's provenance), {tu['sampler'].upper()} found no "
+        "gain set that both completes the digital tier and holds the truth's offset: the trade-off the objective "
+        "sets (failures first) is right for a benchmark that ranks failures first; the budget and the search space "
+        "(integral action is what the truth tiers need) are what leave the calm-truth acceptance unmet.",
+    ]
+    return head + "\n\n" + "\n".join(rows) + "\n\n" + "\n".join(text)
+
+
+def render_text(text: str, res: dict[str, Any]) -> str:
+    """``text`` with its generated block replaced by :func:`block` of ``res``."""
+    if not BLOCK_RE.search(text):
+        raise ValueError(f"{DOC.name}: no <!-- BEGIN GENERATED {NAME} --> block")
+    return BLOCK_RE.sub(lambda m: m.group(1) + block(res) + "\n" + m.group(3), text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``run``, ``render`` or ``check`` (module docstring); returns the exit status."""
+    args = sys.argv[1:] if argv is None else argv
+    if args[:1] == ["run"]:
+        print(run(Path(args[1]) if len(args) > 1 else RESULT))
+        return 0
+    if args[:1] not in (["render"], ["check"]):
+        print("usage: python -m tools.pid_preset_gap run [OUT.json] | render | check", file=sys.stderr)
+        return 2
+    res = json.loads(RESULT.read_text())
+    text = DOC.read_text()
+    new = render_text(text, res)
+    if args[0] == "render":
+        DOC.write_text(new)
+        return 0
+    if new != text:
+        print(f"{DOC.relative_to(ROOT)}: the {NAME} block differs from {RESULT.relative_to(ROOT)}; run "
+              "python -m tools.pid_preset_gap render", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
