@@ -13,8 +13,9 @@
 * **cap** of the median and mean of task means: a failed run counts as the error at which the
   suite's run score saturates, ``[run_score]`` cap x the metric's scale (10 x 0.5 m = 5 m of
   ``xtrack_rmse`` in v2), divided by its cell's divisor like every run; a completed run above it
-  is capped there too.  Without a scale for the metric: ``cap`` times the divisor.  The median and mean stay finite when runs fail, and the failure rate of each
-  controller is recorded next to them (``failure_rate``);
+  is capped there too.  Without a scale for the metric: ``cap`` times the divisor.  The median
+  and mean stay finite when runs fail, and the failure rate of each controller is recorded next
+  to them (``failure_rate``);
 * **intervals**: the stratified bootstrap with strata = tasks (the tiers of a task share their
   seeds), one set of draws for every controller (paired), the suite's confidence and bootstrap
   size, generators ``SeedSequence([seed, crc32("aggregates/<statistic>")])``.

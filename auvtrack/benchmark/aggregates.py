@@ -63,7 +63,8 @@ import numpy as np
 
 from . import statistics as st
 
-__all__ = ["AGGREGATES", "CAPPED", "iqm", "capped", "aggregate_median", "aggregate_mean", "optimality_gap", "performance_profile",
+__all__ = ["AGGREGATES", "CAPPED", "iqm", "capped", "aggregate_median", "aggregate_mean", "optimality_gap",
+           "performance_profile",
            "probability_of_improvement", "stratified_draws", "bootstrap_replicates", "Estimate", "Profile",
            "ScoreMatrices", "AggregateEstimates", "score_matrices", "reference_scales", "normalise",
            "aggregate_estimates", "performance_profiles", "improvement_probabilities"]
