@@ -271,6 +271,19 @@ def block(res: dict[str, Any]) -> str:
     _require(len(stiffer) >= 2 and all(med(a) > med(b) for a, b in zip(stiffer, stiffer[1:])),
              "the cell error does not fall with kp")
     _require(med(ki_var) > target, "the designed ki alone meets the target")
+    _require(abs(med(sh, col="xtrack_rmse_late") - med(sh)) < 0.1 * med(sh), "the shipped error is not steady")
+    _require(max(sh["cell_evaluation"]["max"][c] for c in ("t_act_limit_q", "t_act_limit_r")) < 1.0,
+             "the shipped preset saturates on the cell")
+    _require(med(sh, col="energy") >= med(old, col="energy") and effort < 0.1 * terms["xtrack_rmse"],
+             "the effort terms matter on the cell")
+    _require(sh["cell_evaluation"]["score_mean"] > max(old["cell_evaluation"]["score_mean"],
+                                                       des["cell_evaluation"]["score_mean"]),
+             "the run score prefers the shipped preset on the cell")
+    _require(max(product) < 1.25 * min(product), "the error x kp is not about constant")
+    _require(ki_var["cell_evaluation"]["max"]["t_act_limit_r"] > sh["cell_evaluation"]["max"]["t_act_limit_r"] + 10.0,
+             "the designed ki does not wind up against the rudder")
+    _require(not any(not r["training"]["failures"] and med(r) <= target for r in v.values()),
+             "a gain set completes the training split and meets the target")
     text = [
         f"* **Not the seeds.** The shipped preset's median on the cell is {_g(med(sh, 'cell_training'))} m on the "
         f"training seeds and {_g(med(sh))} m on the evaluation seeds: it misses by as much on the seeds it was tuned on.",
