@@ -28,7 +28,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from . import aggregates as ag
-from .leaderboard import _rng
+from .leaderboard import _rng, metric_info
 
 __all__ = ["aggregate_analysis", "REFERENCE", "normalisation", "failure_caps", "profile_taus"]
 
@@ -97,10 +97,11 @@ def failure_caps(scales: dict[tuple, float], score: str, run_score) -> tuple[dic
     scale = run_score.scales.get(score)
     if scale is not None:
         ceiling = float(run_score.cap) * float(scale)
+        unit = metric_info(score)[1]
         return ({k: ceiling / v for k, v in scales.items()},
-                f"a failed run counts as a `{score}` of {ceiling:g} (where the run score saturates: `[run_score]` "
-                f"cap {run_score.cap:g} x scale {scale:g}), divided by its cell's divisor like every run; a completed "
-                "run above it counts as it too")
+                f"a failed run counts as `{score}` = {ceiling:g} {unit} (where the run score saturates: `[run_score]` "
+                f"cap {run_score.cap:g} x scale {scale:g} {unit}), divided by its cell's divisor like every run; a "
+                "completed run above it counts as it too")
     return ({k: float(run_score.cap) for k in scales},
             f"a failed run counts as {run_score.cap:g} (the `[run_score]` cap) times its cell's divisor; a completed "
             "run above it counts as it too")
