@@ -752,18 +752,24 @@ def block_compare_v2(cv: dict) -> str:
     s, t = cv["suite"], cv["timing"]
     agg = cv.get("aggregates") or {}
     iqm = (agg.get("estimates") or {}).get("iqm", {})
+    mean = (agg.get("estimates") or {}).get("mean", {})
+    rule = agg.get("cap_rule")
+    capped = " (capped)" if rule else ""
     pooled = {r["controller"]: r for r in cv["pooled"]}
     rows = ["| rank | controller | score | rank 95 % CI | failure rate [Wilson 95 %] | IQM of normalised `"
-            f"{agg.get('score', '?')}` [95 %] | gains |", "|---|---|---|---|---|---|---|"]
+            f"{agg.get('score', '?')}` [95 %] | mean of task means{capped} [95 %] | gains |",
+            "|---|---|---|---|---|---|---|---|"]
     gains = {c["label"]: c["gains"] for c in cv["controllers"]}
+
+    def interval(q: dict | None) -> str:
+        return f"{_f(q['point'])} [{_f(q['low'])}, {_f(q['high'])}]" if q and q["point"] is not None else "not finite"
+
     for r in cv["leaderboard"]:
         c = r["controller"]
-        q = iqm.get(c)
         rows.append(f"| {r['rank']:g} | `{c}` | {r['score']:.2f} | [{r['rank_interval']['low']:g}, "
                     f"{r['rank_interval']['high']:g}] | {100 * pooled[c]['failure_rate']:.1f} % "
-                    f"{_pct_ci(*pooled[c]['failure_ci'])} | "
-                    + (f"{_f(q['point'])} [{_f(q['low'])}, {_f(q['high'])}]" if q and q["point"] is not None
-                       else "not finite") + f" | {gains[c]} |")
+                    f"{_pct_ci(*pooled[c]['failure_ci'])} | {interval(iqm.get(c))} | {interval(mean.get(c))} | "
+                    f"{gains[c]} |")
     fails = sum(r["failures"] for r in cv["pooled"])
     unknown = sum(r["causes"].get("unknown", 0) for r in cv["pooled"])
     by_cause: dict[str, int] = {}
@@ -778,7 +784,9 @@ def block_compare_v2(cv: dict) -> str:
             f"({', '.join(cv['criteria'])}), lower is better; rank interval: the rule on resampled seeds. "
             f"Normalisation of the aggregates: {agg.get('normalisation', 'none')}; IQM with "
             f"{agg.get('n_resamples', '?')} stratified-bootstrap replicates (strata: {', '.join(agg.get('strata', []))}); "
-            "not finite when more than a quarter of a controller's runs failed (a failed run is `inf`).")
+            "not finite when more than a quarter of a controller's runs failed (a failed run is `inf`)"
+            + (f"; in the mean of the (task, tier) cells' mean normalised `{agg.get('score', '?')}`, {rule} "
+               "(docs/benchmark.md): read it with the failure rate." if rule else "."))
     tail = [_untuned_text(cv), "",
             f"{fails} runs failed, {unknown} of them without a recorded cause"
             + (" (by cause: " + ", ".join(f"{k} {v}" for k, v in sorted(by_cause.items())) + ")" if by_cause else "")

@@ -10,6 +10,12 @@
   median (the LOS autopilot, the vehicle-level baseline) when it is a competitor with a finite,
   positive median in every cell; otherwise the metric's ``[run_score]`` scale (one value for
   every cell); with neither, no aggregate (the reason is recorded);
+* **cap** of the median and mean of task means: a failed run counts as the error at which the
+  suite's run score saturates, ``[run_score]`` cap x the metric's scale (10 x 0.5 m = 5 m of
+  ``xtrack_rmse`` in v2), divided by its cell's divisor like every run; a completed run above it
+  is capped there too.  Without a scale for the metric: ``cap`` times the divisor.  The median
+  and mean stay finite when runs fail, and the failure rate of each controller is recorded next
+  to them (``failure_rate``);
 * **intervals**: the stratified bootstrap with strata = tasks (the tiers of a task share their
   seeds), one set of draws for every controller (paired), the suite's confidence and bootstrap
   size, generators ``SeedSequence([seed, crc32("aggregates/<statistic>")])``.
@@ -22,9 +28,9 @@ from typing import Any, Sequence
 import numpy as np
 
 from . import aggregates as ag
-from .leaderboard import _rng
+from .leaderboard import _rng, metric_info
 
-__all__ = ["aggregate_analysis", "REFERENCE", "normalisation", "profile_taus"]
+__all__ = ["aggregate_analysis", "REFERENCE", "normalisation", "failure_caps", "profile_taus"]
 
 REFERENCE = "los_autopilot"
 """The reference controller of the normalisation: the LOS autopilot, the baseline real AUVs fly."""
@@ -71,6 +77,36 @@ def normalisation(df, score: str, controllers: Sequence[str], scale: float | Non
     return None, f"no normalisation: the LOS autopilot's medians cannot serve ({why}) and `{score}` has no scale"
 
 
+def failure_caps(scales: dict[tuple, float], score: str, run_score) -> tuple[dict[tuple, float], str]:
+    """The cap of each cell's normalised scores in the median and mean of task means, and the rule.
+
+    Parameters
+    ----------
+    scales : dict
+        ``{(task, tier): divisor}`` (:func:`normalisation`).
+    score : str
+        The metric normalised.
+    run_score : auvtrack.benchmark.suite.RunScore
+        The suite's ``[run_score]`` (its ``cap`` and ``scales``).
+
+    Returns
+    -------
+    (dict, str)
+        ``{(task, tier): cap}`` (finite, > 0) and a one-line description of the rule (for the report).
+    """
+    scale = run_score.scales.get(score)
+    if scale is not None:
+        ceiling = float(run_score.cap) * float(scale)
+        unit = metric_info(score)[1]
+        return ({k: ceiling / v for k, v in scales.items()},
+                f"a failed run counts as `{score}` = {ceiling:g} {unit} (where the run score saturates: `[run_score]` "
+                f"cap {run_score.cap:g} x scale {scale:g} {unit}), divided by its cell's divisor like every run; a "
+                "completed run above it counts as it too")
+    return ({k: float(run_score.cap) for k in scales},
+            f"a failed run counts as {run_score.cap:g} (the `[run_score]` cap) times its cell's divisor; a completed "
+            "run above it counts as it too")
+
+
 def profile_taus(values: np.ndarray, n: int = 61) -> np.ndarray:
     """The tau grid of the performance profiles: ``n`` points on [0, tau_max].
 
@@ -110,7 +146,9 @@ def aggregate_analysis(df, suite, controllers: Sequence[str]) -> dict[str, Any]:
     -------
     dict
         ``score``, ``normalisation`` (the rule), ``scales`` (``{"task/tier": divisor}``),
-        ``strata``, ``n_resamples``, ``confidence``, ``estimates`` (``{aggregate: {controller:
+        ``strata``, ``n_resamples``, ``confidence``, ``cap`` (``{"task/tier": cap}`` of the
+        median and mean of task means) and ``cap_rule`` (its description), ``failure_rate``
+        (``{controller: failed runs / runs}``), ``estimates`` (``{aggregate: {controller:
         {"point", "low", "high"}}}``), ``profiles`` (``{controller: {"taus", "fraction", "low",
         "high"}}``) and ``improvement`` (``[{"x", "y", "point", "low", "high"}]``, every ordered
         pair); without a normalisation only ``score``, ``normalisation`` and ``estimates = None``.
@@ -126,13 +164,17 @@ def aggregate_analysis(df, suite, controllers: Sequence[str]) -> dict[str, Any]:
     runs["norm"] = ag.normalise(df, score, scales, cells=CELLS).to_numpy()
     sm = ag.score_matrices(runs, "norm", cells=CELLS, strata=STRATA, controllers=list(controllers))
     n, level = suite.bootstrap_resamples, f.confidence
-    est = ag.aggregate_estimates(sm, _rng(f.seed, "aggregates/estimates"), n_resamples=n, confidence=level)
+    caps, cap_rule = failure_caps(scales, score, f.run_score)
+    est = ag.aggregate_estimates(sm, _rng(f.seed, "aggregates/estimates"), cap=[caps[c] for c in sm.cells],
+                                 n_resamples=n, confidence=level)
+    failed = {c: float((runs.loc[runs["controller"] == c, "status"] != "ok").mean()) for c in sm.scores}
     taus = profile_taus(runs["norm"].to_numpy(dtype=float))
     prof = ag.performance_profiles(sm, taus, _rng(f.seed, "aggregates/profiles"), n_resamples=n, confidence=level)
     poi = ag.improvement_probabilities(sm, _rng(f.seed, "aggregates/improvement"), n_resamples=n, confidence=level)
     return out | {
         "scales": {f"{k[0]}/{k[1]}": v for k, v in scales.items()}, "strata": list(STRATA), "n_resamples": n,
-        "confidence": level, "estimates": est.to_dict(),
+        "confidence": level, "cap": {f"{k[0]}/{k[1]}": v for k, v in caps.items()}, "cap_rule": cap_rule,
+        "failure_rate": failed, "estimates": est.to_dict(),
         "profiles": {c: p.to_dict() for c, p in prof.items()},
         "improvement": [{"x": x, "y": y, **e.to_dict()} for (x, y), e in poi.items()],
     }

@@ -138,7 +138,7 @@ def figure_improvement_probabilities(probabilities: Mapping[tuple[str, str], Est
 
 
 def figure_aggregate_intervals(estimates: AggregateEstimates, *, aggregates: Sequence[str] | None = None,
-                               controllers: Sequence[str] | None = None):
+                               controllers: Sequence[str] | None = None, titles: Mapping[str, str] | None = None):
     """Interval estimates of the aggregates: one panel per aggregate, one row per controller.
 
     Parameters
@@ -149,6 +149,8 @@ def figure_aggregate_intervals(estimates: AggregateEstimates, *, aggregates: Seq
         Panels, left to right (default: every aggregate in ``estimates``).
     controllers : sequence of str, optional
         Rows, top to bottom (default: the order of ``estimates``).
+    titles : mapping of str to str, optional
+        Panel titles by aggregate (default: :data:`AGGREGATE_LABELS`).
 
     Returns
     -------
@@ -174,7 +176,7 @@ def figure_aggregate_intervals(estimates: AggregateEstimates, *, aggregates: Seq
         edge = _finite_edge([v for c in names for v in (per[c].low, per[c].high, per[c].point)])
         for y, c in zip(ys, names):
             _interval_row(ax, float(y), per[c], colors[c], edge)
-        ax.set_title(AGGREGATE_LABELS.get(a, a), fontsize=9)
+        ax.set_title({**AGGREGATE_LABELS, **(titles or {})}.get(a, a), fontsize=9)
         ax.set_xlim(right=edge * 1.08 if edge > 0 else edge + 0.1)
         ax.grid(axis="x", alpha=0.3)
     axes[0].set_yticks(ys, names)

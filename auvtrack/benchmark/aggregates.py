@@ -5,7 +5,9 @@ reinforcement learning at the edge of the statistical precipice", NeurIPS 2021 (
 library), on the benchmark's runs (``docs/benchmark.md``, "Aggregates across tasks"):
 
 * :func:`iqm`, :func:`aggregate_median`, :func:`aggregate_mean`, :func:`optimality_gap`: the
-  aggregates of a (runs, tasks) score matrix (their section 4.3, rliable's ``metrics``);
+  aggregates of a (runs, tasks) score matrix (their section 4.3, rliable's ``metrics``); the
+  median and mean of task means take an optional ``cap`` (:func:`capped`), at which a failure
+  counts instead of ``inf``;
 * :func:`performance_profile`: the fraction of runs whose score is at most tau (their section
   4.2; Dolan & More 2002);
 * :func:`probability_of_improvement`: P(X < Y) + P(X = Y)/2 per task, averaged over the tasks
@@ -61,7 +63,8 @@ import numpy as np
 
 from . import statistics as st
 
-__all__ = ["AGGREGATES", "iqm", "aggregate_median", "aggregate_mean", "optimality_gap", "performance_profile",
+__all__ = ["AGGREGATES", "CAPPED", "iqm", "capped", "aggregate_median", "aggregate_mean", "optimality_gap",
+           "performance_profile",
            "probability_of_improvement", "stratified_draws", "bootstrap_replicates", "Estimate", "Profile",
            "ScoreMatrices", "AggregateEstimates", "score_matrices", "reference_scales", "normalise",
            "aggregate_estimates", "performance_profiles", "improvement_probabilities"]
@@ -143,43 +146,93 @@ def iqm(scores: Any) -> np.ndarray | float:
     return float(out) if np.ndim(out) == 0 else np.asarray(out, dtype=float)
 
 
-def aggregate_median(scores: Any) -> np.ndarray | float:
+def _check_cap(cap: Any) -> float | np.ndarray | None:
+    if cap is None:
+        return None
+    c = np.array(cap, dtype=float)
+    if c.ndim > 1 or c.size == 0 or not np.all(np.isfinite(c) & (c > 0.0)):
+        raise ValueError(f"cap: must be finite and > 0 (one number, or one per task), or None (got {cap})")
+    return float(c) if c.ndim == 0 else c
+
+
+def capped(scores: Any, cap: Any) -> np.ndarray:
+    """Scores with every value above the cap (a failure's ``inf`` too) set to the cap.
+
+    The task means of :func:`aggregate_median` and :func:`aggregate_mean` use capped scores when
+    a cap is given: a failed run then counts as the cap, a large finite score, instead of
+    ``inf``, which would make every mean it enters ``inf`` and hide everything else about the
+    controller.
+
+    Parameters
+    ----------
+    scores : array_like
+        Scores shaped ``(..., tasks)`` (lower is better); ``nan`` counts as ``+inf``.
+    cap : float, sequence of float or None
+        Finite and > 0 (in the scores' unit): one number, or one per task (the last axis), or
+        None for no cap.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``min(s, cap)``, element by element (the scores unchanged, ``nan`` as ``inf``, for None).
+    """
+    x = _scores(scores)
+    c = _check_cap(cap)
+    if c is None:
+        return x
+    if np.ndim(c) == 1 and c.shape[0] != x.shape[-1]:
+        raise ValueError(f"cap: need one per task ({x.shape[-1]}), got {c.shape[0]}")
+    return np.minimum(x, c)
+
+
+def aggregate_median(scores: Any, cap: Any = None) -> np.ndarray | float:
     """Median over the tasks of the per-task mean score (rliable's ``aggregate_median``).
 
-    One failed run makes its task's mean ``inf``; the median is ``inf`` once more than half the
-    tasks hold a failure (for an even number of tasks, once the upper middle one does).
+    Without a cap, one failed run makes its task's mean ``inf``, and the median is ``inf`` once
+    more than half the tasks hold a failure (for an even number of tasks, once the upper middle
+    one does).  With a cap, each score enters its task mean as ``min(s, cap)`` (:func:`capped`):
+    a failure counts as the cap and the median is finite.
 
     Parameters
     ----------
     scores : array_like
         Shape ``(..., runs, tasks)``; ``nan`` counts as ``+inf``.
+    cap : float, sequence of float or None, optional
+        Finite and > 0, one number or one per task: the value of a failure and the largest value
+        of a completed run (None: rliable's uncapped statistic).
 
     Returns
     -------
     float or numpy.ndarray
         The median of the task means, one per batch.
     """
-    x = _matrix(scores)
+    x = capped(_matrix(scores), cap)
     out = np.median(np.mean(x, axis=-2), axis=-1)
     return float(out) if np.ndim(out) == 0 else out
 
 
-def aggregate_mean(scores: Any) -> np.ndarray | float:
+def aggregate_mean(scores: Any, cap: Any = None) -> np.ndarray | float:
     """Mean over the tasks of the per-task mean score (rliable's ``aggregate_mean``).
 
-    One failed run anywhere makes it ``inf``.
+    Without a cap, one failed run anywhere makes it ``inf``.  With a cap, each score enters its
+    task mean as ``min(s, cap)`` (:func:`capped`): a failure counts as the cap, so the mean is
+    finite, and a failure rate f in a task adds at most f times that task's cap to its mean;
+    the benchmark states the failure rate next to it.
 
     Parameters
     ----------
     scores : array_like
         Shape ``(..., runs, tasks)``; ``nan`` counts as ``+inf``.
+    cap : float, sequence of float or None, optional
+        Finite and > 0, one number or one per task: the value of a failure and the largest value
+        of a completed run (None: rliable's uncapped statistic).
 
     Returns
     -------
     float or numpy.ndarray
         The mean of the task means, one per batch.
     """
-    x = _matrix(scores)
+    x = capped(_matrix(scores), cap)
     out = np.mean(np.mean(x, axis=-2), axis=-1)
     return float(out) if np.ndim(out) == 0 else out
 
@@ -283,6 +336,8 @@ AGGREGATES: dict[str, Callable[..., Any]] = {
     "optimality_gap": optimality_gap,
 }
 """Aggregate name -> statistic of a ``(..., runs, tasks)`` matrix (lower is better for each)."""
+CAPPED = ("median", "mean")
+"""The aggregates that take a ``cap`` (the averages of task means, which one ``inf`` would make ``inf``)."""
 
 
 # ---------------------------------------------------------------------------- the bootstrap
@@ -720,7 +775,8 @@ class AggregateEstimates:
 def aggregate_estimates(data, rng: np.random.Generator, *, score: str | None = None,
                         cells: Sequence[str] = ("task", "tier"), strata: Sequence | None = None,
                         aggregates: Sequence[str] = tuple(AGGREGATES), gamma: float = 1.0,
-                        n_resamples: int = 2000, confidence: float = 0.95) -> AggregateEstimates:
+                        cap: Any = None, n_resamples: int = 2000,
+                        confidence: float = 0.95) -> AggregateEstimates:
     """IQM, median, mean and optimality gap of every controller with stratified-bootstrap intervals.
 
     One set of stratified draws (:func:`stratified_draws`) resamples every controller: the
@@ -745,6 +801,10 @@ def aggregate_estimates(data, rng: np.random.Generator, *, score: str | None = N
         Names among :data:`AGGREGATES`.
     gamma : float, optional
         Target error of the optimality gap.
+    cap : float, sequence of float or None, optional
+        Cap of the median and mean of task means (:data:`CAPPED`, :func:`capped`), one number or
+        one per column: a failure counts as the cap there; None (default): rliable's uncapped
+        statistics.
     n_resamples : int, optional
         Bootstrap replicates.
     confidence : float, optional
@@ -759,10 +819,11 @@ def aggregate_estimates(data, rng: np.random.Generator, *, score: str | None = N
     bad = [a for a in aggregates if a not in AGGREGATES]
     if bad or not aggregates:
         raise ValueError(f"aggregates: names among {list(AGGREGATES)} (got {list(aggregates)})")
-    g = _check_gamma(gamma)
+    g, c = _check_gamma(gamma), _check_cap(cap)
     sm = _as_matrices(data, score, cells, strata)
     draws = _draws(sm, n_resamples, rng)
-    stats = {a: (lambda s, f=AGGREGATES[a]: f(s, g)) if a == "optimality_gap" else AGGREGATES[a] for a in aggregates}
+    stats = {a: (lambda s, f=AGGREGATES[a]: f(s, g)) if a == "optimality_gap" else
+             (lambda s, f=AGGREGATES[a]: f(s, c)) if a in CAPPED else AGGREGATES[a] for a in aggregates}
     out: dict[str, dict[str, Estimate]] = {a: {} for a in aggregates}
     for name, mat in sm.scores.items():
         for a, f in stats.items():

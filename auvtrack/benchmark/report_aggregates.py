@@ -12,7 +12,7 @@ import numpy as np
 from ..report import fmt
 from .aggregate_plots import (AGGREGATE_LABELS, figure_aggregate_intervals, figure_improvement_probabilities,
                               figure_performance_profiles)
-from .aggregates import AggregateEstimates, Estimate, Profile
+from .aggregates import CAPPED, AggregateEstimates, Estimate, Profile
 
 __all__ = ["write_aggregates_section"]
 
@@ -44,18 +44,25 @@ def write_aggregates_section(rep: Any, agg: Mapping[str, Any], order: Sequence[s
         return
     level = float(agg["confidence"])
     pct = f"{100 * level:g} %"
+    capped = agg.get("cap_rule")
+    means = (f"the median and mean of the per-cell means of capped scores ({capped}; so one failure does not "
+             "make them `inf`, and the failure rate stands next to them)" if capped
+             else "the median and mean of the per-cell means")
     rep.paragraph(f"After Agarwal et al. (2021, `rliable`): the interquartile mean (IQM) of every normalised run "
-                  f"(finite while at most a quarter of a controller's runs fail), the median and mean of the "
-                  f"per-cell means, and the optimality gap at 1 (the mean of max(0, 1 - 1/r)); {pct} stratified-"
+                  f"(finite while at most a quarter of a controller's runs fail), {means}, and the optimality gap "
+                  f"at 1 (the mean of max(0, 1 - 1/r)); {pct} stratified-"
                   f"bootstrap intervals ({agg['n_resamples']} replicates, strata = {', '.join(agg['strata'])}: "
                   "the tiers of a task share their seeds), the same resampled seeds for every controller "
                   "(paired). Definitions: `docs/benchmark.md`.")
     est = agg["estimates"]
     aggs = list(est)
-    rep.table(["controller"] + [f"{AGGREGATE_LABELS.get(a, a)} [{pct}]" for a in aggs],
-              [[c] + [_interval(est[a][c]) for a in aggs] for c in order])
+    rates = agg.get("failure_rate")
+    titles = {a: f"{AGGREGATE_LABELS.get(a, a)}{' (capped)' if capped and a in CAPPED else ''}" for a in aggs}
+    rep.table(["controller"] + [f"{titles[a]} [{pct}]" for a in aggs] + (["failure rate"] if rates else []),
+              [[c] + [_interval(est[a][c]) for a in aggs] + ([f"{100 * rates[c]:.1f} %"] if rates else [])
+               for c in order])
     objects = AggregateEstimates({a: {c: _estimate(est[a][c], level) for c in order} for a in aggs}, level)
-    rep.figure(figure_aggregate_intervals(objects, controllers=list(order)), "aggregates",
+    rep.figure(figure_aggregate_intervals(objects, controllers=list(order), titles=titles), "aggregates",
                f"Aggregates of the normalised `{score}` with {pct} stratified-bootstrap intervals")
     profiles = {c: Profile(*(np.asarray(agg["profiles"][c][k], dtype=float)
                              for k in ("taus", "fraction", "low", "high")), level) for c in order}

@@ -54,6 +54,41 @@ def test_median_mean_and_gap_by_hand():
     assert ag.optimality_gap([[0.0]]) == 0.0                  # a perfect run adds nothing
 
 
+def test_capped_median_and_mean_by_hand():
+    """A failed run counts as the cap in its task's mean, a completed run above the cap as the cap."""
+    x = np.array([[0.5, 2.0, 1.0],
+                  [1.0, INF, 3.0],                            # a failed run
+                  [1.5, 30.0, 2.0]])                          # a completed run above the cap
+    assert ag.aggregate_mean(x) == INF and ag.aggregate_median(x) == 2.0  # rliable's, uncapped
+    # capped at 10: task means (0.5 + 1 + 1.5) / 3 = 1, (2 + 10 + 10) / 3 = 22/3, (1 + 3 + 2) / 3 = 2
+    assert ag.aggregate_mean(x, cap=10.0) == pytest.approx((1.0 + 22.0 / 3.0 + 2.0) / 3.0, rel=1e-15)
+    assert ag.aggregate_median(x, cap=10.0) == 2.0
+    assert ag.aggregate_mean(x, cap=0.5) == 0.5               # every score at or above the cap
+    assert ag.aggregate_mean([[np.nan]], cap=4.0) == 4.0      # nan is a failure
+    assert ag.capped(x, None)[1, 1] == INF and ag.capped(x, 10.0).max() == 10.0
+    # one cap per task: 4, 10, 2 -> task means (0.5 + 1 + 1.5) / 3 = 1, 22/3, (1 + 2 + 2) / 3 = 5/3
+    assert ag.aggregate_mean(x, cap=[4.0, 10.0, 2.0]) == pytest.approx((1.0 + 22.0 / 3.0 + 5.0 / 3.0) / 3.0, rel=1e-15)
+    assert ag.aggregate_median(x, cap=[4.0, 10.0, 2.0]) == pytest.approx(5.0 / 3.0, rel=1e-15)
+    for bad in (0.0, -1.0, INF, np.nan, [1.0, 0.0, 1.0], [[1.0]]):
+        with pytest.raises(ValueError, match="cap: must be finite and > 0"):
+            ag.aggregate_mean(x, cap=bad)
+    with pytest.raises(ValueError, match=r"cap: need one per task \(3\), got 2"):
+        ag.aggregate_mean(x, cap=[1.0, 2.0])
+
+
+def test_capped_estimates_cap_the_means_only():
+    """``aggregate_estimates(cap=...)`` caps the median and mean; the IQM and the gap are unchanged."""
+    x = {"a": np.array([[0.5, 2.0], [1.0, INF], [1.5, 3.0], [0.7, 2.5]])}
+    plain = ag.aggregate_estimates(x, np.random.default_rng(5), n_resamples=200)
+    cap = ag.aggregate_estimates(x, np.random.default_rng(5), n_resamples=200, cap=10.0)
+    assert plain.estimates["mean"]["a"].point == INF
+    assert cap.estimates["mean"]["a"].point == pytest.approx((3.7 / 4 + 17.5 / 4) / 2, rel=1e-15)
+    assert np.all(np.isfinite(cap.estimates["mean"]["a"].replicates))
+    assert np.all(cap.estimates["mean"]["a"].replicates <= 10.0)
+    for a in ("iqm", "optimality_gap"):
+        assert cap.estimates[a]["a"].to_dict() == plain.estimates[a]["a"].to_dict()
+
+
 def test_probability_of_improvement_by_hand():
     # pairs (x, y): 1<2, 1<3, 2=2 (1/2), 2<3 -> 3.5 / 4
     assert ag.probability_of_improvement([[1.0], [2.0]], [[2.0], [3.0]]) == 0.875

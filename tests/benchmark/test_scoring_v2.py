@@ -159,7 +159,17 @@ def test_failures_are_infinite_and_a_unusable_reference_falls_back_to_the_scale(
     df = lb.derive_metrics(_runs(np.random.default_rng(2), fail=fail), "5cm", suite.file.scoring.criteria())
     agg = aggregate_analysis(df, suite, [REFERENCE, "A", "B"])
     assert set(agg["scales"].values()) == {0.5} and "cannot serve" in agg["normalisation"]
-    assert agg["estimates"]["mean"][REFERENCE]["point"] == INF  # a failure makes its cell's mean inf
+    # the median and mean of task means count a failure as where the run score saturates: cap x scale
+    # = 10 x 0.5 = 5 of xtrack_rmse, normalised by the cell's divisor (here the scale 0.5): 10
+    assert suite.file.run_score.cap == 10.0 and set(agg["cap"].values()) == {10.0}
+    assert "`xtrack_rmse` = 5 m" in agg["cap_rule"]
+    los = df[df["controller"] == REFERENCE]
+    r = np.where(los["status"] == "ok", los["xtrack_rmse"] / 0.5, INF)
+    cell_means = pd.Series(np.minimum(r, 10.0)).groupby([los["task"].to_numpy(), los["tier"].to_numpy()]).mean()
+    assert cell_means[("line", "calm")] > 5 * 10.0 / 8  # the five failures, at 10 each
+    assert agg["estimates"]["mean"][REFERENCE]["point"] == pytest.approx(cell_means.mean(), rel=1e-12)
+    assert agg["estimates"]["median"][REFERENCE]["point"] == pytest.approx(cell_means.median(), rel=1e-12)
+    assert agg["failure_rate"] == {REFERENCE: 5 / 32, "A": 0.0, "B": 0.0}
     assert math.isfinite(agg["estimates"]["iqm"][REFERENCE]["point"])  # 5 of 32 runs: below a quarter
     assert max(agg["profiles"][REFERENCE]["fraction"]) <= 1 - 5 / 32
 
@@ -267,8 +277,13 @@ def test_a_v2_like_comparison_end_to_end(tmp_path):
     assert (runs["cause"][runs["status"] != "ok"] != "").all()  # every failure has a cause
     md = (tmp_path / "out" / "report.md").read_text()
     for text in ("## Aggregates across tasks", "objective (train / validation)", "xtrack_rmse (m) median [95 % bootstrap]",
-                 "failure rate, all runs [Wilson 95 %]"):
+                 "failure rate, all runs [Wilson 95 %]", "mean of task means (capped) [95 %]",
+                 "median of task means (capped) [95 %]", "a failed run counts as `xtrack_rmse` = 5 m"):
         assert text in md, text
+    scales = agg["scales"]  # the LOS autopilot's medians: a failure counts as 5 m over each
+    assert agg["cap"] == pytest.approx({k: 5.0 / v for k, v in scales.items()}, rel=1e-15)
+    assert set(agg["failure_rate"]) == {"pid", REFERENCE}
+    assert all(math.isfinite(agg["estimates"][a][c]["point"]) for a in ("median", "mean") for c in ("pid", REFERENCE))
     assert set(doc["not_tuned_on_suite"]) == {"pid", REFERENCE}  # the tiny suite has no preset tuned on it
     assert "**Not tuned on this suite** (2 of 2)" in md and len(doc["tuning"]) == 2
     assert ("Why it failed" in md) == bool((runs["status"] != "ok").any())

@@ -135,3 +135,43 @@ def test_untuned_competitors_are_named_from_the_result(small):
     assert "Every competitor's gains were tuned by `auvtrack tune` on auv-track-v2 v1" in findings.block_compare_v2(tuned)
     old = {k: v for k, v in small.items() if k != "not_tuned_on_suite"}
     assert "not recorded in this result" in findings.block_compare_v2(old)
+
+
+def _uncaused(cv: dict) -> list[str]:
+    """Every (tier, controller) of the report's *Why it failed* table whose failures lack a named cause,
+    and every cell whose causes do not add up to its failures."""
+    from auvtrack.benchmark.report_competitors import failure_cause_rows
+
+    head, rows = failure_cause_rows(cv["pooled_tier"])
+    causes = head[3:]
+    out = [f"{r[0]}/{r[1]}: unknown" for r in rows if "unknown" in causes and r[3 + causes.index("unknown")]]
+    failing = {(r["tier"], r["controller"]): r["failures"] for r in cv["pooled_tier"] if r["failures"]}
+    shown = {(r[0], r[1]): sum(r[3:]) for r in rows}
+    out += [f"{t}/{c}: {k} failed, {shown.get((t, c), 0)} with a cause in the table" for (t, c), k in failing.items()
+            if shown.get((t, c)) != k]
+    out += [f"{c['tier']}/{c['task']}/{c['controller']}: causes {c['causes']} for {c['failures']} failures"
+            for c in cv["cells"] if sum(c["causes"].values()) != c["failures"] or "unknown" in c["causes"]]
+    return out
+
+
+def test_every_failure_of_every_tier_of_the_stored_result_has_a_cause_in_the_report():
+    """The acceptance's second clause on docs/results/compare-v2.json: the report's *Why it failed* table
+    (built from the stored ``pooled_tier``) names a cause for every failed run of every tier, and every
+    cell's causes add up to its failures."""
+    cv = findings.load("compare-v2")
+    assert sum(r["failures"] for r in cv["pooled_tier"]) > 0  # there are failures to explain
+    assert sum(r["failures"] for r in cv["pooled_tier"]) == sum(r["failures"] for r in cv["pooled"])
+    assert _uncaused(cv) == []
+
+
+def test_the_cause_check_finds_a_failure_without_a_cause(small):
+    assert _uncaused(small) == []
+    broken = copy.deepcopy(small)
+    row = next(r for r in broken["pooled_tier"] if r["failures"])
+    cause = next(iter(row["causes"]))
+    row["causes"]["unknown"] = 1
+    row["causes"][cause] -= 1
+    assert [p for p in _uncaused(broken) if p.endswith("unknown")] == [f"{row['tier']}/{row['controller']}: unknown"]
+    cell = next(c for c in broken["cells"] if c["failures"])
+    cell["failures"] += 1
+    assert any(p.startswith(f"{cell['tier']}/{cell['task']}/{cell['controller']}") for p in _uncaused(broken))
