@@ -13,17 +13,9 @@ from auvtrack.cli import main
 from auvtrack.gym import train as train_mod
 from cli_process import HANG_S, CliProcess
 
-from .test_env import TINY
+from .test_train import suite_file  # noqa: F401  (the fixture: the tiny suite with its splits)
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX signals")
-SPLITS = "\n[splits.training]\nseeds = [100, 108]\n[splits.validation]\nseeds = [200, 204]\n"
-
-
-@pytest.fixture
-def suite_file(tmp_path):
-    path = tmp_path / "tiny_split.toml"
-    path.write_text(TINY + SPLITS)
-    return path
 
 
 def _args(suite_file, out):
