@@ -16,7 +16,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.linalg import expm
 
@@ -167,6 +167,7 @@ def _eps_ddot(e, ed, edd, rho, rhod, rhodd):
 
 @settings(max_examples=60)
 @given(st.integers(0, 2**32 - 1))
+@example(57988)  # rho near rho_inf, |xi| near 0.95: the transformation amplifies the difference quotient's error
 def test_ppc_transformed_error_obeys_its_design_law_at_any_state(seed):
     """eps_ddot = -kp eps - kd eps_dot (eq. R4) at states spread over the envelope (|xi| up to 0.95)."""
     rng, eta, nu, att, refm, t = _state(seed)
@@ -176,9 +177,13 @@ def test_ppc_transformed_error_obeys_its_design_law_at_any_state(seed):
     refm[0] = np.array(virtual_point(eta, att, VP_NOM[LAYOUT.ell])) - xi * rho[:, 0]  # e = xi rho
     status, tau, _, aux = _call(ppc, cc, t, eta, nu, att, np.zeros(0), refm)
     e, ed, _ = (np.array(x) for x in error_state(eta, att, nu, refm, VP_NOM))
-    epsdd, epsd = _eps_ddot(e, ed, e_ddot_nominal(eta, nu, tau, refm), *rho.T)
+    edd = e_ddot_nominal(eta, nu, tau, refm)
+    epsdd, epsd = _eps_ddot(e, ed, edd, *rho.T)
     assert status == 0
-    _close(epsdd, -3.0 * np.arctanh(xi) - 2.5 * epsd, 1e-6)
+    # e_ddot (central differences) to 1e-7 relative, as for the other laws, carried into eps_ddot by
+    # d eps_ddot / d e_ddot = 1 / (rho (1 - xi^2)): up to 4000 near rho_inf with |xi| = 0.95
+    tol = 1e-7 * (1.0 + np.abs(edd)) / (rho[:, 0] * (1.0 - xi**2))
+    assert np.all(np.abs(epsdd - (-3.0 * np.arctanh(xi) - 2.5 * epsd)) <= tol), (seed, epsdd, epsd)
     _close(aux, np.concatenate([rho[:, 0], np.arctanh(xi)]), 1e-12)
 
 
