@@ -14,18 +14,10 @@ from auvtrack.gym.env import TrackEnv, compile_steps
 from auvtrack.gym.stepping import step_module
 from auvtrack.gym.vector import TrackVectorEnv
 
-from .test_env import TINY
+from .test_train import suite_file  # noqa: F401  (the fixture: the tiny suite with its splits)
 
-SPLITS = "\n[splits.training]\nseeds = [100, 108]\n[splits.validation]\nseeds = [200, 204]\n"
 NOTICE = "compiling kernels (first run only, about"
 ROOT = Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture
-def suite_file(tmp_path):
-    path = tmp_path / "tiny_split.toml"
-    path.write_text(TINY + SPLITS)
-    return path
 
 
 @pytest.fixture
