@@ -132,7 +132,10 @@ class ChunkJob:
 
     # ---------------------------------------------------------------- how a chunk is computed
     def warm_local(self, workers: int | None, progress: bool = True) -> float:
-        """Compile or load what the local runs need before they are timed (``progress``: a bar); the seconds it took."""
+        """Compile or load what the local runs need before they are timed; the seconds it took.
+
+        ``progress``: the "compiling kernels" notice and a bar; without it nothing is printed.
+        """
         return 0.0
 
     def run_local(self, ids: range, workers: int | None):

@@ -230,7 +230,8 @@ def run_sweep(study: str | Path | SweepSpec, out: str | Path, *, workers: int | 
     max_chunks : int, optional
         Stop after this many chunks have been written (the rest stay to ``resume``).
     progress : bool, optional
-        Show a tqdm bar (samples done, rate, ETA).
+        Show a tqdm bar (samples done, rate, ETA) and, when kernels compile first, their notice and
+        bar; without it nothing is printed.
     client : distributed.Client, optional
         Use this client (its cluster is left running); overrides ``workers``/``scheduler``.
     memory_limit : str or int, optional
@@ -260,7 +261,8 @@ def run_sweep(study: str | Path | SweepSpec, out: str | Path, *, workers: int | 
     if cluster is not None:  # local workers load the kernels from the disk cache: compile them here, visibly
         from ..simulation.compiling import warmup
 
-        warmup(progress=progress)  # what each worker's warm-up loads (sweep_worker.worker_warmup)
+        # what each worker's warm-up loads (sweep_worker.worker_warmup); without progress, silently
+        warmup(progress=progress, notice=None if progress else (lambda text: None))
     res = execute_chunks(SweepJob(spec), out, resume=resume, client=client, scheduler=scheduler,
                          start_cluster=cluster, max_chunks=max_chunks, progress=progress, on_chunk=on_chunk)
     summary = None

@@ -417,6 +417,10 @@ def warm_runs(specs: Sequence[RunSpec], workers: int | None = None, backend: str
     return time.perf_counter() - t0
 
 
+def _silent(text: str) -> None:
+    """A notice nobody asked for (``--quiet``)."""
+
+
 class CompareJob(ChunkJob):
     """A comparison as a job of the chunk executor: its runs in chunks of ``chunk_size``.
 
@@ -497,8 +501,9 @@ class CompareJob(ChunkJob):
         return hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()
 
     def warm_local(self, workers: int | None, progress: bool = True) -> float:
-        """:func:`warm_runs` of one run per (controller, tier, plant preset)."""
-        return warm_runs(_warm_specs(self.suite, self.entries), workers, self.backend, progress=progress)
+        """:func:`warm_runs` of one run per (controller, tier, plant preset); without ``progress``, silently."""
+        return warm_runs(_warm_specs(self.suite, self.entries), workers, self.backend, progress=progress,
+                         notice=None if progress else _silent)
 
     def run_local(self, ids: range, workers: int | None):
         """The runs ``ids`` over ``workers`` threads of the batch runner."""

@@ -40,7 +40,7 @@ def _resume_command(study: str, folder: Path, workers: int | None, worker_memory
 @click.option("--resume", is_flag=True, help="Finish an interrupted sweep in --out: completed chunks are verified "
               "(fingerprint, content hash) and kept; bad ones are named and recomputed.")
 @click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
-@click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("--quiet", is_flag=True, help="No progress bar, no compile notice or bar.")
 def sweep(study: str, out: str | None, workers: int | None, worker_memory: str, scheduler: str | None, resume: bool,
           max_chunks: int | None, quiet: bool) -> None:
     """Run the parameter sweep / Monte Carlo study STUDY (a TOML file) on Dask: Parquet rows, quantiles, --resume.

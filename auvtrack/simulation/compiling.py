@@ -157,7 +157,7 @@ def compile_first(pairs: Sequence[tuple[str, str]], *, progress: bool = False) -
 
 
 def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, progress: bool = False,
-           simd: bool = False) -> dict:
+           simd: bool = False, notice: Callable[[str], None] | None = None) -> dict:
     """Compile (or load from the on-disk cache) the kernel of every controller on every plant.
 
     Kernels that are not cached compile in parallel, one process per core
@@ -174,6 +174,9 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     simd : bool, optional
         Also compile each pair's SIMD batch kernel (``run_batch(..., backend="simd")``), which
         otherwise compiles on first use.
+    notice : callable, optional
+        Receives the "compiling kernels (first run only, about N s)" line when a kernel is not
+        cached (default: standard error).
 
     Returns
     -------
@@ -182,7 +185,7 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     """
     keys = kernel_keys(builtin_pairs(controllers, plants))
     t0 = time.perf_counter()
-    done = kernels.warmup(keys, progress=progress, lanes=simd)
+    done = kernels.warmup(keys, progress=progress, lanes=simd, notice=notice)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
             "seconds": round(time.perf_counter() - t0, 2)}
 

@@ -71,7 +71,8 @@ def tune_folder(out: str | Path) -> Path:
 
 
 def tune_newcomers(suite, entries: Sequence, trials: int, out: str | Path, *, seed: int = 0,
-                   workers: int | None = 1, progress: Callable[[str], None] | None = None) -> list:
+                   workers: int | None = 1, progress: Callable[[str], None] | None = None,
+                   quiet: bool = False) -> list:
     """The comparison's entries with every plug-in tuned on the suite's training split.
 
     Parameters
@@ -91,6 +92,8 @@ def tune_newcomers(suite, entries: Sequence, trials: int, out: str | Path, *, se
         Threads of the batch runner inside a trial.
     progress : callable, optional
         Receives one line per finished tuning.
+    quiet : bool, optional
+        Tune silently (:func:`auvtrack.tuning.tune`'s ``quiet``: no compile notice, no Optuna log).
 
     Returns
     -------
@@ -107,7 +110,7 @@ def tune_newcomers(suite, entries: Sequence, trials: int, out: str | Path, *, se
             result.append(e)
             continue
         res = tune(e.table["module"], source, trials=trials, out=tune_folder(out) / e.label, seed=seed,
-                   workers=workers)
+                   workers=workers, quiet=quiet)
         if not res.best_params:
             raise ValueError(f"--tune: {e.label}: no trial of {trials} completed the training split "
                              f"({res.pruned} pruned, {res.refused} refused); see {tune_folder(out) / e.label}")
@@ -122,7 +125,8 @@ def tune_newcomers(suite, entries: Sequence, trials: int, out: str | Path, *, se
 
 
 def tuned_entries(suite, controllers: list[str] | None, plugins: Sequence[str], budget: str, out: str | Path,
-                  *, workers: int | None = None, progress: Callable[[str], None] | None = None) -> list:
+                  *, workers: int | None = None, progress: Callable[[str], None] | None = None,
+                  quiet: bool = False) -> list:
     """The competitors of ``compare --tune``: built-ins as usual, plug-ins tuned at ``budget``.
 
     Parameters
@@ -141,6 +145,8 @@ def tuned_entries(suite, controllers: list[str] | None, plugins: Sequence[str], 
         Threads of the batch runner inside a trial (None: 1).
     progress : callable, optional
         One line per finished tuning.
+    quiet : bool, optional
+        Tune silently (``compare --quiet``).
 
     Returns
     -------
@@ -165,4 +171,4 @@ def tuned_entries(suite, controllers: list[str] | None, plugins: Sequence[str], 
         raise ValueError(f"--tune: must be a number of trials >= 1, or no value for the suite's shared budget "
                          f"(got {budget!r})")
     entries = resolve_controllers(controllers, list(plugins), suite.file.gain_preset)
-    return tune_newcomers(suite, entries, trials, out, workers=workers or 1, progress=progress)
+    return tune_newcomers(suite, entries, trials, out, workers=workers or 1, progress=progress, quiet=quiet)

@@ -324,7 +324,11 @@ def test_a_local_sweep_compiles_its_kernels_in_the_client_with_a_progress_bar(tm
     example = Path(__file__).resolve().parents[2] / "scenarios" / "sweep_example.toml"
     with pytest.raises(Stop):
         sweep_module.run_sweep(example, tmp_path / "out", workers=1, progress=True)
-    assert calls == [{"progress": True}]
+    assert calls == [{"progress": True, "notice": None}]  # the notice on standard error, and a bar
+    with pytest.raises(Stop):  # --quiet: no bar, and the notice goes nowhere
+        sweep_module.run_sweep(example, tmp_path / "out-quiet", workers=1, progress=False)
+    quiet = calls.pop()
+    assert quiet["progress"] is False and callable(quiet["notice"]) and quiet["notice"]("compiling kernels") is None
     monkeypatch.setattr(sweep_module, "execute_chunks", lambda *a, **k: (_ for _ in ()).throw(Stop()))
     with pytest.raises(Stop):
         sweep_module.run_sweep(example, tmp_path / "out2", scheduler="tcp://127.0.0.1:1", progress=True)
