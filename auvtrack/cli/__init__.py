@@ -5,11 +5,13 @@ output folder that cannot be written) prints ONE line to stderr and exits with s
 traceback, and before anything runs.  ``check`` runs exactly the validation of ``run`` (load,
 plan, controller set-up), so it refuses the same scenarios with the same message.  A simulation
 that fails (divergence, pitch limit, envelope violation) keeps and saves its partial result,
-prints the diagnostic and exits 3.  Ctrl-C stops a run within about a second, saves what was
-computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps its
-completed chunks for ``--resume`` and exits 130 (so does ``compare``; ``tune`` keeps its study,
-``train`` its checkpoint).  Those four stop the same way on SIGTERM.  ``auvtrack --help`` lists
-every command and these exit codes.
+prints the diagnostic and exits 3.  Ctrl-C or SIGTERM stops a run within about a second, saves
+what was computed with status ``interrupted`` and exits 130; a sweep closes its cluster, keeps
+its completed chunks for ``--resume`` and exits 130 (so does ``compare``; ``tune`` keeps its
+study, ``train`` its checkpoint).  Every command runs inside one handler of both signals
+(:func:`auvtrack.cli.signals.stop_once`): the first stops the command with one line and exit
+130, later ones are ignored while it cleans up.  ``auvtrack --help`` lists every command and
+these exit codes.
 """
 from __future__ import annotations
 
@@ -20,6 +22,7 @@ import click
 
 from . import compare, perf, run, scenarios, studies, sweep, train, tune  # noqa: F401  (each registers its commands on the group)
 from .common import EXIT_BAD_INPUT, EXIT_CODES, EXIT_INTERRUPTED, EXIT_SIM_FAILED, VERBOSE, cli, one_line
+from .signals import stop_once
 
 __all__ = ["cli", "main", "EXIT_BAD_INPUT", "EXIT_SIM_FAILED", "EXIT_INTERRUPTED", "EXIT_CODES"]
 
@@ -51,6 +54,16 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
+    """Run one command inside the signal handling every command shares (:func:`~auvtrack.cli.signals.stop_once`)."""
+    with stop_once():  # SIGINT and SIGTERM alike: the first stops the command, later ones wait for its clean-up
+        try:
+            return _dispatch(argv)
+        except KeyboardInterrupt:  # a signal while an error message was printed
+            click.echo("auvtrack: interrupted", err=True)
+            return EXIT_INTERRUPTED
+
+
+def _dispatch(argv: list[str] | None) -> int:
     from ..scenario import ScenarioError
 
     warnings.simplefilter("default")

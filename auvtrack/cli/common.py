@@ -101,7 +101,7 @@ EXIT_CODES = (("0", "success"),
               ("2", "bad input: one line naming the field and the allowed range, no traceback, nothing run"),
               ("3", "a simulation failed (diverged, pitch limit, envelope violated): the diagnostic is printed "
                     "and the partial result kept"),
-              ("130", "interrupted (Ctrl-C; SIGTERM too for sweep, compare, tune and train): a run keeps its partial "
+              ("130", "interrupted (Ctrl-C or SIGTERM, any command): a run keeps its partial "
                       "result, a sweep or a comparison its completed chunks, a tuning its study, a training its "
                       "completed iterations"))
 EXIT_CODES_HELP = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + "."
@@ -124,6 +124,12 @@ class _Group(click.Group):
                 if (c := self.get_command(ctx, n)) is not None and not c.hidden]
         with formatter.section("Commands"):
             formatter.write_dl(rows)
+
+    def invoke(self, ctx: click.Context):  # noqa: D102 - Ctrl-C or SIGTERM: one line (click prints an empty one first)
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            raise click.exceptions.Abort() from None
 
     def format_epilog(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         with formatter.section("Exit status"):

@@ -90,7 +90,7 @@ def resume_command(suite_name: str, quick: bool, controllers: list[str] | None, 
 @click.option("--resume", is_flag=True, help="Finish an interrupted comparison in --out: finished chunks are verified "
               "(fingerprint, content hash) and kept; bad ones are named and recomputed.")
 @click.option("--max-chunks", type=int, default=None, hidden=True, help="Stop after this many chunks (testing).")
-@click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("--quiet", is_flag=True, help="No progress bar, no compile notice or bar (as tune and train).")
 @click.option("--tune", "tune_budget", is_flag=False, flag_value="suite", default=None, metavar="[TRIALS]",
               help="Tune each --plugin first (auvtrack tune on the suite's training split, in <out>-tune/) at the "
                    "suite's shared budget (its presets' trials) or TRIALS; it enters with its best gains.")
@@ -124,7 +124,7 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
     folder = Path(out) if out else default_out(suite)
     again = resume_command(suite_name, quick, names, plugins, folder, backend, scheduler, workers, max_runs,
                            tune_budget)
-    with stop_once():  # Ctrl-C or SIGTERM: stop once, the finished chunks stay for --resume
+    with stop_once():  # Ctrl-C or SIGTERM (the command line's handling): the finished chunks stay for --resume
         try:
             entries, tuned_dir = None, None
             if tune_budget is not None:
@@ -132,7 +132,8 @@ def compare(suite_name: str, controllers: tuple[str, ...], plugins: tuple[str, .
 
                 tuned_dir = tune_folder(folder)
                 try:
-                    entries = tuned_entries(suite, names, plugins, tune_budget, folder, progress=click.echo)
+                    entries = tuned_entries(suite, names, plugins, tune_budget, folder, progress=click.echo,
+                                            quiet=quiet)
                 except ValueError as exc:  # one line naming --tune (a SuiteError is one too)
                     raise BadInput(one_line(exc)) from None
             res = _compare(suite, controllers=names, plugins=list(plugins), out=folder, scheduler=scheduler,

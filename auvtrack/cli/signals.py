@@ -1,11 +1,14 @@
-"""Ctrl-C and SIGTERM for long commands (``sweep``, ``compare``): stop once, then let the clean-up finish.
+"""Ctrl-C and SIGTERM for every command: stop once, then let the clean-up finish.
 
-The first SIGINT or SIGTERM raises ``KeyboardInterrupt`` in the main thread, so the command
-stops its work, closes its Dask cluster or its batch and keeps what it finished.  Later signals
-are ignored until the process exits: a second Ctrl-C while a cluster closes would otherwise
-interrupt the shutdown and print a traceback instead of the one-line message.  (The workers of
-a cluster the command starts ignore SIGINT themselves:
-:class:`auvtrack.batch.sweep_worker.IgnoreInterruptsPlugin`.)
+:func:`auvtrack.cli.main` runs every command inside :func:`stop_once`, so that a new command
+gets the same handling without a line of its own: the first SIGINT or SIGTERM raises
+``KeyboardInterrupt`` in the main thread, so the command stops its work (a run keeps its
+partial result, a sweep closes its Dask cluster and keeps its chunks) and exits 130 with one
+line.  Later signals are ignored until the process exits: a second Ctrl-C while a cluster
+closes would otherwise interrupt the shutdown and print a traceback instead of the one-line
+message.  A command that asks whether to stop between its steps (``tune``, ``train``) enters
+:func:`stop_once` again and gets the same ``requested()``.  (The workers of a cluster the
+command starts ignore SIGINT themselves: :class:`auvtrack.batch.sweep_worker.IgnoreInterruptsPlugin`.)
 """
 from __future__ import annotations
 
@@ -16,12 +19,17 @@ from typing import Callable, Iterator
 
 __all__ = ["stop_once", "stop_requests"]
 
+_ACTIVE: list[Callable[[], bool]] = []
+"""The ``requested()`` of the :func:`stop_once` in force (the outermost), if any."""
+
 
 @contextlib.contextmanager
 def stop_once() -> Iterator[Callable[[], bool]]:
     """Turn the first SIGINT or SIGTERM into ``KeyboardInterrupt`` and ignore the ones after it.
 
-    Outside the main thread (where Python delivers signals) nothing is changed.  An exception
+    Outside the main thread (where Python delivers signals) nothing is changed, and inside another
+    :func:`stop_once` (the command line's, around every command) neither: the outer one's
+    ``requested()`` is yielded.  An exception
     raised while Python runs a callback (a weak reference's, one of LLVM's while Numba compiles)
     is dropped, so the ``KeyboardInterrupt`` can be lost: a command checks ``requested()`` between
     its steps (trials, iterations) and stops there.
@@ -37,6 +45,9 @@ def stop_once() -> Iterator[Callable[[], bool]]:
     if threading.current_thread() is not threading.main_thread():
         yield lambda: False
         return
+    if _ACTIVE:  # nested: the outer handlers stay in force
+        yield _ACTIVE[-1]
+        return
     stopping = []
 
     def _stop(signum, frame):
@@ -45,10 +56,15 @@ def stop_once() -> Iterator[Callable[[], bool]]:
         stopping.append(signum)
         raise KeyboardInterrupt
 
+    def requested() -> bool:
+        return bool(stopping)
+
     previous = {sig: signal.signal(sig, _stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    _ACTIVE.append(requested)
     try:
-        yield lambda: bool(stopping)
+        yield requested
     finally:
+        _ACTIVE.remove(requested)
         for sig, handler in previous.items():  # once stopping, the process is ending: stay deaf until it exits
             signal.signal(sig, signal.SIG_IGN if stopping else handler)
 

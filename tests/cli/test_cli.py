@@ -140,5 +140,5 @@ def test_subcommand_help_lists_the_exit_codes(capsys):
         text = " ".join(capsys.readouterr().out.split())
         for code, meaning in EXIT_CODES:
             assert f"{code} {' '.join(meaning.split())}" in text, (args, code)
-        assert "130 interrupted (Ctrl-C; SIGTERM too for sweep, compare, tune and train): a run keeps its partial result" \
+        assert "130 interrupted (Ctrl-C or SIGTERM, any command): a run keeps its partial result" \
             in text

@@ -1,5 +1,5 @@
-"""Ctrl-C and failures keep what was computed: a SIGINT stops a long run within seconds (partial
-result written, status interrupted, exit 130), batches and sweeps stop cleanly, and a failed run
+"""Ctrl-C and failures keep what was computed: a SIGINT or a SIGTERM stops a long run within seconds
+(partial result written, status interrupted, exit 130), batches and sweeps stop cleanly, and a failed run
 records the steps it actually ran and its last finite state."""
 from __future__ import annotations
 
@@ -87,7 +87,9 @@ def compiled():
     auvtrack.simulate(PAPER, ["sim.duration=0.01"], warn=False)
 
 
-def test_sigint_stops_a_long_run_within_seconds_and_keeps_its_partial_result(tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_stops_a_long_run_within_seconds_and_keeps_its_partial_result(tmp_path, sig):
+    """Ctrl-C and SIGTERM (``kill``, a batch system's stop) are one mechanism: the same stop, the same folder."""
     out = tmp_path / "long"
     script = _signal_when_running("auvtrack.simulation.pipeline", 1) + textwrap.dedent(f"""
         from auvtrack.cli import main
@@ -96,7 +98,7 @@ def test_sigint_stops_a_long_run_within_seconds_and_keeps_its_partial_result(tmp
     p = _start(["-c", script])
     assert any(ln.startswith("running 20000000 RK4 steps") for ln in _wait_for(p.stderr, READY))
     t0 = time.monotonic()
-    p.send_signal(signal.SIGINT)
+    p.send_signal(sig)
     stdout, stderr = p.communicate(timeout=60)
     elapsed = time.monotonic() - t0
     assert p.returncode == EXIT_INTERRUPTED, stderr

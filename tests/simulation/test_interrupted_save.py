@@ -75,7 +75,7 @@ DRIVER = textwrap.dedent("""
                 Fh.n += 1
                 if Fh.n == 2:  # the header and the first block are written
                     open(sys.argv[2], "w").write(repr(time.time()))
-                    os.kill(os.getpid(), signal.SIGINT)
+                    os.kill(os.getpid(), getattr(signal, sys.argv[4]))
         return write(self, Fh(), stop)
     Result._write_csv = write_then_ctrl_c
     sys.exit(main(["run", sys.argv[1], "--out", sys.argv[3], "--set", "sim.duration=10",
@@ -83,10 +83,11 @@ DRIVER = textwrap.dedent("""
 """)
 
 
-def test_ctrl_c_while_the_cli_writes_keeps_the_folder_and_exits_130_at_once(tmp_path):
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_ctrl_c_while_the_cli_writes_keeps_the_folder_and_exits_130_at_once(tmp_path, sig):
     auvtrack.simulate(PAPER, ["sim.duration=0.01"], warn=False)  # the subprocess loads the kernel from the cache
     stamp, out = tmp_path / "signalled", tmp_path / "run"
-    p = subprocess.run([sys.executable, "-c", DRIVER, str(PAPER), str(stamp), str(out)], cwd=tmp_path,
+    p = subprocess.run([sys.executable, "-c", DRIVER, str(PAPER), str(stamp), str(out), sig], cwd=tmp_path,
                        env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=600,
                        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     ended = time.time()
