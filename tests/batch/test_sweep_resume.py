@@ -131,41 +131,96 @@ def test_the_cli_default_worker_memory_is_the_library_s():
     assert cli_sweep.DEFAULT_WORKER_MEMORY == DEFAULT_WORKER_MEMORY
 
 
-def test_ctrl_c_twice_closes_the_cluster_without_a_traceback_and_resume_finishes(tmp_path):
-    """SIGINT to the whole process group (as a terminal's Ctrl-C), then again while the cluster closes."""
+def _descendants(pid: int) -> list[int]:
+    """Every process under ``pid`` (Linux: read from /proc): a local cluster's nannies and workers."""
+    parent = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                parent[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            except (OSError, ValueError, IndexError):
+                continue
+    found, todo = [], [pid]
+    while todo:
+        here = todo.pop()
+        kids = [c for c, p in parent.items() if p == here]
+        found += kids
+        todo += kids
+    return found
+
+
+def _chunks(out: Path) -> dict[str, bytes]:
+    return {f.name: f.read_bytes() for f in sorted((out / "chunks").glob("chunk-*.parquet"))}
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX signals, /proc")
+@pytest.mark.parametrize("sig, to_group", [(signal.SIGINT, True), (signal.SIGTERM, False)], ids=["ctrl-c", "kill"])
+def test_a_second_signal_while_the_cluster_closes_exits_130_promptly_and_resume_finishes(tmp_path, sig, to_group):
+    """A stop, then the same signal again while the sweep shuts down: exit 130 without a traceback, within
+    seconds, the cluster's processes ended, every chunk written before the stop kept as it was, and the
+    printed resume command, run verbatim, completes the sweep.
+
+    Ctrl-C reaches the whole process group (a terminal's foreground job: the command and its workers);
+    ``kill`` reaches the command only, which must end its workers itself.
+    """
+    from cli_process import HANG_S, wait_gone
+
+    samples = 12
     path = tmp_path / "slow.toml"
-    path.write_text(textwrap.dedent("""
+    path.write_text(textwrap.dedent(f"""
         name = "twice"
         set = ["sim.duration=300", "sim.log_dt=1", "controller.kind=ftsmc"]
-        samples = 30
+        samples = {samples}
         chunk_size = 1
     """))
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2]))
     cmd = [sys.executable, "-m", "auvtrack.cli", "sweep", str(path), "--out", str(out), "--workers", "1", "--quiet"]
     p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         start_new_session=True)
-    t0 = time.monotonic()
-    while not list((out / "chunks").glob("chunk-*.parquet")):
-        assert p.poll() is None and time.monotonic() - t0 < 600, p.stderr.read()
-        time.sleep(0.2)
-    os.killpg(p.pid, signal.SIGINT)
-    for delay in (0.3, 0.3, 0.5):  # again, while the cluster is closing
-        time.sleep(delay)
+                         start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    send = (lambda: os.killpg(p.pid, sig)) if to_group else (lambda: p.send_signal(sig))
+    try:
+        t0 = time.monotonic()
+        while not (out / "chunks").is_dir() or not list((out / "chunks").glob("chunk-*.parquet")):
+            assert p.poll() is None and time.monotonic() - t0 < 600, p.stderr.read()
+            time.sleep(0.2)
+        workers = _descendants(p.pid)
+        before = _chunks(out)
+        assert workers and before
+        t_stop = time.monotonic()
+        send()
+        time.sleep(0.05)
+        assert p.poll() is None  # the shutdown is under way: the second signal lands in it
+        send()
+        for delay in (0.3, 0.5):  # and again, while the cluster is closing
+            time.sleep(delay)
+            if p.poll() is None:
+                send()
+        _, err = p.communicate(timeout=HANG_S)
+        elapsed = time.monotonic() - t_stop
+    finally:
         if p.poll() is None:
-            os.killpg(p.pid, signal.SIGINT)
-    _, err = p.communicate(timeout=120)
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
     assert p.returncode == 130, err
     assert "Traceback" not in err and "CancelledError" not in err, err
     assert "sweep interrupted" in err and "--resume" in err
-    done = len(list((out / "chunks").glob("chunk-*.parquet")))
-    assert 1 <= done < 30 and not (out / "results.parquet").exists()
+    assert elapsed < HANG_S, elapsed
+    assert wait_gone(workers, HANG_S) == []  # no nanny or worker left behind
+    after = _chunks(out)
+    assert {k: after.get(k) for k in before} == before  # written before the stop: kept, byte for byte
+    assert len(after) < samples and not (out / "results.parquet").exists()
+    import pyarrow.parquet as pq
+
+    for name in after:  # every chunk on disk is whole
+        assert pq.read_table(out / "chunks" / name).num_rows == 1
     command = err.strip().splitlines()[-1].split("finish with: ", 1)[1]
-    q = subprocess.run([sys.executable, "-m", "auvtrack.cli", *shlex.split(command)[1:], "--quiet"], env=env,
+    q = subprocess.run([sys.executable, "-m", "auvtrack.cli", *shlex.split(command)[1:]], env=env,
                        capture_output=True, text=True, timeout=1800)
     assert q.returncode == 0, q.stderr
     df = read_results(out)
-    assert df["sample"].tolist() == list(range(30)) and (df["status"] == "ok").all()
+    assert df["sample"].tolist() == list(range(samples)) and (df["status"] == "ok").all()
 
 
 def test_the_limits_table_and_messages_of_the_docs_are_the_code_s(tmp_path, monkeypatch):
