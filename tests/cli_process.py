@@ -18,10 +18,10 @@ HANG_S = 60.0
 class CliProcess:
     """``python -m auvtrack.cli ARGS`` with this checkout first on the path; stderr read line by line."""
 
-    def __init__(self, args: list[str], env: dict | None = None) -> None:
+    def __init__(self, args: list[str], env: dict | None = None, cwd: str | Path | None = None) -> None:
         full_env = {**os.environ, "PYTHONPATH": str(ROOT), **(env or {})}
         self.proc = subprocess.Popen([sys.executable, "-m", "auvtrack.cli", *args], stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True, env=full_env)
+                                     stderr=subprocess.PIPE, text=True, env=full_env, cwd=cwd)
         self.lines: list[str] = []
         self._queue: queue.Queue = queue.Queue()
         self._out: list[str] = []

@@ -16,8 +16,10 @@ from __future__ import annotations
 
 import json
 import math
+import multiprocessing
+import signal
 import warnings
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -146,6 +148,12 @@ def preset_overrides(name: str) -> list[str]:
     out (keys written next to a preset win), so the comparison sets each one.
     """
     return [f"controller.{k}={v!r}" for k, v in get_gain_preset(name).gains.items()]
+
+
+def _figure_worker() -> None:
+    """A figure process leaves Ctrl-C to its parent (which terminates it) and ends quietly on SIGTERM."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _render(job: tuple[str, list, Path, dict]) -> tuple[str, float]:
@@ -284,29 +292,32 @@ def reproduce(out: Path, *, quick: bool = False, progress: bool = False) -> str:
     window = (10.0, 20.0) if quick else (50.0, 100.0)  # steady state: accuracy and chattering claims
     compile_first([(kind, "5dof") for _, kind in CONTROLLERS], progress=progress)
     bar = tqdm(total=2 * len(CONTROLLERS) + len(FIGURES), disable=not progress, desc="reproduce", unit="step")
-    runs, full, steady, steady_runs = {}, {}, {}, {}
-    tuned, tuned_full, tuned_steady = {}, {}, {}
-    for label, kind in CONTROLLERS:
-        bar.set_postfix_str(kind)
-        res, res_ss = _run(kind, overrides, window)
-        res.save(out / kind, mat=True)
-        runs[label], full[label], steady[label] = res, res.metrics, res_ss.metrics
-        steady_runs[label] = res_ss
-        bar.update()
-        bar.set_postfix_str(TUNED_PRESETS[kind])
-        res, res_ss = _run(kind, [*overrides, *preset_overrides(TUNED_PRESETS[kind])], window)
-        res.save(out / "tuned" / kind)
-        tuned[label], tuned_full[label], tuned_steady[label] = res, res.metrics, res_ss.metrics
-        bar.update()
-    pairs = list(runs.items())
-    kw = {"fig6_inputs": {"steady_from": window[0]}}
-    jobs = [(name, pairs, out / "figures", kw.get(name, {})) for name, _ in FIGURES]
-    text_px = {}
-    with ProcessPoolExecutor(max_workers=default_workers()) as pool:  # figures are independent: one per core
-        for name, text_px[name] in pool.map(_render, jobs):
-            bar.set_postfix_str(name)
+    try:  # a stop (Ctrl-C, SIGTERM) closes the bar first: the one-line message starts a line
+        runs, full, steady, steady_runs = {}, {}, {}, {}
+        tuned, tuned_full, tuned_steady = {}, {}, {}
+        for label, kind in CONTROLLERS:
+            bar.set_postfix_str(kind)
+            res, res_ss = _run(kind, overrides, window)
+            res.save(out / kind, mat=True)
+            runs[label], full[label], steady[label] = res, res.metrics, res_ss.metrics
+            steady_runs[label] = res_ss
             bar.update()
-    bar.close()
+            bar.set_postfix_str(TUNED_PRESETS[kind])
+            res, res_ss = _run(kind, [*overrides, *preset_overrides(TUNED_PRESETS[kind])], window)
+            res.save(out / "tuned" / kind)
+            tuned[label], tuned_full[label], tuned_steady[label] = res, res.metrics, res_ss.metrics
+            bar.update()
+        pairs = list(runs.items())
+        kw = {"fig6_inputs": {"steady_from": window[0]}}
+        jobs = [(name, pairs, out / "figures", kw.get(name, {})) for name, _ in FIGURES]
+        text_px = {}
+        # figures are independent: one process per core; leaving the block (done, or a stop) terminates them
+        with multiprocessing.Pool(default_workers(), initializer=_figure_worker) as pool:
+            for name, text_px[name] in pool.imap(_render, jobs):
+                bar.set_postfix_str(name)
+                bar.update()
+    finally:
+        bar.close()
     sc_default = load_scenario(paper_scenario_path(), ["controller.kind=fxtntsmc", *overrides])
     cond = conditions(sc_default, notes=tuple(runs["FXTNTSMC"].meta.get("notes", ())))
     cond_tuned = conditions(sc_default, gains=f"tuned presets {', '.join(TUNED_PRESETS.values())}",
