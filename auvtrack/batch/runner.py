@@ -19,6 +19,7 @@ Two parallel back ends (measured in ``benchmarks/results.md``):
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import threading
 import time
@@ -43,7 +44,7 @@ from ..simulation.result import Result
 BACKENDS = ("threads", "prange", "serial", "simd")
 
 __all__ = ["RunSummary", "run_metrics", "run_batch", "iter_batch", "BACKENDS", "default_workers", "StopSignal",
-           "BatchInterrupted", "preferred_backend"]
+           "BatchInterrupted", "preferred_backend", "stoppable_pool"]
 
 
 @dataclass(frozen=True)
@@ -101,6 +102,34 @@ def preferred_backend(threads: str = "threads") -> str:
 def default_workers() -> int:
     """Number of worker threads used when none is given: the usable cores (:func:`auvtrack.engine.kernels.usable_cores`)."""
     return kernels.usable_cores()
+
+
+@contextlib.contextmanager
+def stoppable_pool(workers: int | None = None) -> Iterator[ThreadPoolExecutor]:
+    """A thread pool whose queued work is dropped when the block is left by an exception (Ctrl-C, SIGTERM).
+
+    ``with ThreadPoolExecutor(...)`` waits, on any exit, until every submitted job has run: a stop
+    during a study would first run all of its remaining simulations.  Here an exception (a
+    ``KeyboardInterrupt`` from a signal, or a job's error) cancels the jobs not yet started and
+    does not wait; the ones running finish on their own (the interpreter joins them at exit).
+
+    Parameters
+    ----------
+    workers : int, optional
+        Threads (default :func:`default_workers`).
+
+    Yields
+    ------
+    concurrent.futures.ThreadPoolExecutor
+        The pool; on a normal exit it is shut down waiting for its jobs, as a ``with`` block would.
+    """
+    pool = ThreadPoolExecutor(max_workers=workers or default_workers())
+    try:
+        yield pool
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
 
 
 class StopSignal:

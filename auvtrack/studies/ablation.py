@@ -37,14 +37,13 @@ from __future__ import annotations
 import math
 import re
 import warnings
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from ..batch.runner import default_workers
+from ..batch.runner import stoppable_pool
 from ..scenario import load_scenario, paper_scenario_path
 from ..simulation.compiling import compile_first
 from ..simulation.pipeline import prepare, run_prepared
@@ -458,7 +457,7 @@ def _reference_job(job: tuple[Config, str, str, tuple[float, ...], AblationSetti
 def _pool_map(fn, jobs: Sequence, progress: bool, desc: str) -> list:
     from tqdm.auto import tqdm
 
-    with ThreadPoolExecutor(max_workers=default_workers()) as pool:  # the compiled kernel releases the GIL
+    with stoppable_pool() as pool:  # the compiled kernel releases the GIL; a stop drops the queued runs
         return list(tqdm(pool.map(fn, jobs), total=len(jobs), disable=not progress, desc=desc))
 
 
@@ -539,7 +538,7 @@ def _near_threshold(scans: list[dict[str, Any]], cfgs: list[Config], st: Ablatio
             chosen += [cf for cf in cfgs if cf.label == config_label("proactive", "omega")]
             pulse = tuple(amp * x for x in vecs[d])
             jobs = [_scenario(cf, c, st.horizon, pulse, st, log_dt=0.001) for cf in chosen]
-            with ThreadPoolExecutor(max_workers=default_workers()) as pool:
+            with stoppable_pool() as pool:
                 res = list(pool.map(_run, jobs))
             return {"condition": c, "direction": d, "amplitude": amp}, list(zip([cf.label for cf in chosen], res))
     return None, []

@@ -20,14 +20,13 @@ from __future__ import annotations
 import json
 import math
 import warnings
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
-from ..batch.runner import default_workers
+from ..batch.runner import stoppable_pool
 from ..control.fxtntsmc.theory import fixed_time_bounds
 from ..vehicle.kinematics import attitude, j3_inv, virtual_point
 from ..reference import build_reference
@@ -396,7 +395,7 @@ def run(out: Path, *, quick: bool = False, progress: bool = False, settings: Fix
     jobs = [(s0, k, d, float(m), st) for s0 in st.starts for k in st.controllers for d in st.directions
             for m in st.magnitudes]
     compile_first([(k, "5dof") for k in kinds_in(o for v in st.controllers for o in VARIANTS[v])], progress=progress)
-    with ThreadPoolExecutor(max_workers=default_workers()) as pool:  # the compiled kernel releases the GIL
+    with stoppable_pool() as pool:  # the compiled kernel releases the GIL; a stop drops the queued runs
         rows = list(tqdm(pool.map(_run_one, jobs), total=len(jobs), disable=not progress, desc="fixed-time"))
     sc = load_scenario(paper_scenario_path(), [f"sim.duration={st.duration:g}"])
     b = fixed_time_bounds(sc.controller, horizon=st.duration)

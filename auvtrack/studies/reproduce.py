@@ -19,13 +19,12 @@ import math
 import multiprocessing
 import signal
 import warnings
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 from tqdm.auto import tqdm
 
-from ..batch.runner import default_workers
+from ..batch.runner import default_workers, stoppable_pool
 from ..control.fxtntsmc import StartOutsideEnvelope
 from ..control.gain_presets import get_gain_preset
 from ..simulation import plotting
@@ -136,7 +135,7 @@ def _run(kind: str, overrides: list[str], window: tuple[float, float]) -> tuple[
     base = [f"controller.kind={kind}", *overrides]
     preps = [prepare(load_scenario(paper_scenario_path(), base)),
              prepare(load_scenario(paper_scenario_path(), base + [f"metrics.window=[{window[0]}, {window[1]}]"]))]
-    with ThreadPoolExecutor(max_workers=default_workers()) as pool:
+    with stoppable_pool() as pool:
         full, steady = pool.map(run_prepared, preps)
     return full, steady
 

@@ -27,12 +27,12 @@ from __future__ import annotations
 import json
 import math
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
+from ..batch.runner import stoppable_pool
 from ..control import get as get_controller
 from ..scenario import load_scenario
 from ..simulation.compiling import compile_first
@@ -418,7 +418,7 @@ def tune(kind: str, budget: Budget = FULL, objective: Objective = Objective(), *
     total, batch = budget.evaluations(len(space.names)), budget.population
     history: list[float] = []
     wall = time.perf_counter()
-    with ThreadPoolExecutor(max_workers=_threads(workers)) as pool:
+    with stoppable_pool(_threads(workers)) as pool:
         while len(study.trials) < total:  # a batch is asked before any is told: threads do not change it
             trials = [study.ask(dists) for _ in range(min(batch, total - len(study.trials)))]
             for t, value in zip(trials, pool.map(lambda t: mean_cost(dict(t.params)), trials)):
@@ -458,7 +458,7 @@ def evaluate(kind: str, gains: dict[str, float], cases: Sequence[Case], duration
     list of dict
         One record per case (see :func:`run_cost`) with its ``case`` name.
     """
-    with ThreadPoolExecutor(max_workers=_threads(workers)) as pool:
+    with stoppable_pool(_threads(workers)) as pool:
         out = list(pool.map(lambda c: run_cost(c, kind, gains, duration, dt, objective)[1], cases))
     for c, rec in zip(cases, out):
         rec["case"] = c.name
