@@ -71,14 +71,21 @@ def ensure_compiled(preps: Sequence, *, progress: bool = False,
         Receives the notice (default: printed to standard error).
     """
     keys = [p.key for p in preps]
-    pending = {k for k in keys if not kernels.is_compiled(k)}
-    if not pending:
-        return
-    if len(pending) == 1 or kernels.usable_cores() == 1:
-        # compiled in this process (several compile in child processes, which a signal ends)
-        interruptible(lambda: kernels.warmup(keys, progress=progress, notice=notice))
-    else:
-        kernels.warmup(keys, progress=progress, notice=notice)
+    if any(not kernels.is_compiled(k) for k in keys):
+        _warm(keys, progress=progress, notice=notice)
+
+
+def _warm(keys: list[kernels.KernelKey], *, progress: bool = False, notice: Callable[[str], None] | None = None,
+          lanes: bool = False) -> list[kernels.KernelKey]:
+    """:func:`auvtrack.engine.kernels.warmup` so that a signal always stops it.
+
+    Kernels compiled in this process (one pending, or one core) compile in a thread
+    (:func:`interruptible`); several compile in child processes, which the stop ends.
+    """
+    pending = {k for k in keys if not kernels.is_compiled(k) or (lanes and not kernels.is_compiled(k, lanes=True))}
+    if len(pending) == 1 or (pending and kernels.usable_cores() == 1):
+        return interruptible(lambda: kernels.warmup(keys, progress=progress, notice=notice, lanes=lanes))
+    return kernels.warmup(keys, progress=progress, notice=notice, lanes=lanes)
 
 
 def interruptible(fn: Callable[[], T]) -> T:
@@ -153,7 +160,7 @@ def compile_first(pairs: Sequence[tuple[str, str]], *, progress: bool = False) -
     list of KernelKey
         The kernels compiled now (empty when every one was cached).
     """
-    return kernels.warmup(kernel_keys(pairs), progress=progress)
+    return _warm(kernel_keys(pairs), progress=progress)
 
 
 def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, progress: bool = False,
@@ -185,7 +192,7 @@ def warmup(controllers: tuple[str, ...] = (), plants: tuple[str, ...] = (), *, p
     """
     keys = kernel_keys(builtin_pairs(controllers, plants))
     t0 = time.perf_counter()
-    done = kernels.warmup(keys, progress=progress, lanes=simd, notice=notice)
+    done = _warm(keys, progress=progress, lanes=simd, notice=notice)
     return {"kernels": [k.label for k in keys], "compiled": [k.label for k in done],
             "seconds": round(time.perf_counter() - t0, 2)}
 

@@ -85,7 +85,8 @@ def test_warmup_simd_flag_reaches_the_lane_kernel_compile(monkeypatch, capsys):
     from auvtrack.engine import kernels
 
     asked = []
-    monkeypatch.setattr(kernels, "warmup", lambda keys, progress=False, lanes=False: asked.append(lanes) or [])
+    monkeypatch.setattr(kernels, "warmup",
+                        lambda keys, progress=False, lanes=False, notice=None: asked.append(lanes) or [])
     for extra in (["--simd"], []):
         assert main(["warmup", "--controller", "pid", "--plant", "5dof", *extra]) == 0
         assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["kernels"] == ["pid on 5dof"]
