@@ -29,10 +29,11 @@ def stop_once() -> Iterator[Callable[[], bool]]:
 
     Outside the main thread (where Python delivers signals) nothing is changed, and inside another
     :func:`stop_once` (the command line's, around every command) neither: the outer one's
-    ``requested()`` is yielded.  An exception
-    raised while Python runs a callback (a weak reference's, one of LLVM's while Numba compiles)
-    is dropped, so the ``KeyboardInterrupt`` can be lost: a command checks ``requested()`` between
-    its steps (trials, iterations) and stops there.
+    ``requested()`` is yielded.  An exception raised while Python runs a callback (a weak
+    reference's, one of LLVM's while Numba compiles) is dropped, so the ``KeyboardInterrupt`` can
+    be lost: a command checks ``requested()`` between its steps (trials, iterations) and stops
+    there, and compilations in this process run in a thread
+    (:func:`auvtrack.simulation.compiling.interruptible`) so that the main thread only waits.
 
     Yields
     ------
