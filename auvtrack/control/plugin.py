@@ -178,6 +178,10 @@ def _check_compiled(cc: Any, spec: ControllerSpec, law: str) -> CompiledControll
     return dataclasses.replace(cc, aux_names=tuple(cc.aux_names), **arrays)
 
 
+_PROBED: dict = {}
+"""A law's bounds-checked probe copy (:func:`_probe`), by the law's dispatcher."""
+
+
 def _probe(mod, law: str, cc: CompiledController, ctx: SetupContext) -> None:
     """Run the law once at the initial state, compiled with bounds checking: an int status, no bad index."""
     from numba import njit as numba_njit
@@ -188,7 +192,9 @@ def _probe(mod, law: str, cc: CompiledController, ctx: SetupContext) -> None:
 
     from ..interrupt import run_in_thread
 
-    checked = numba_njit(boundscheck=True, nogil=True)(mod.control.py_func)
+    checked = _PROBED.get(mod.control)
+    if checked is None:  # compiled once per law and process: a set-up per episode does not recompile it
+        checked = _PROBED[mod.control] = numba_njit(boundscheck=True, nogil=True)(mod.control.py_func)
     try:
         outcome = run_in_thread(lambda: evaluate(checked, 0.0, ctx.eta0, ctx.nu0, cc.xc0, ctx.refm0, cc.cp,
                                                  ctx.vp_nom, n_aux=len(cc.aux_names)))

@@ -49,3 +49,17 @@ def test_episode_metrics_in_info_and_disabled_autoreset():
     obs, rew, te, tr, info = vec.step(np.zeros((2, 3)))  # ended envs stay ended
     assert np.all(rew == 0.0) and not te.any() and not tr.any() and "metrics" not in info
     assert np.array_equal(vec.carry.ks[:, 0], ks)
+
+
+def test_a_reset_does_not_recompile_the_replay_law():
+    """The plug-in set-up's bounds-checked probe of the replay law is compiled once per process: a reset
+    of new seed indices prepares episodes without compiling (the probe's dispatcher is reused and keeps
+    its one compiled signature)."""
+    from auvtrack.control import plugin
+    from auvtrack.gym import replay
+
+    vec = TrackVectorEnv(2, SUITE, "line", "model", duration=0.2)
+    vec.reset(seed=[1, 2])
+    probe = plugin._PROBED[replay.control]
+    vec.reset(seed=[3, 4])
+    assert plugin._PROBED[replay.control] is probe and len(probe.signatures) == 1
