@@ -65,6 +65,54 @@ def reset_rows(sizes: tuple[int, ...], repeat: int, suite: str = "auv-track-v2",
     return rows
 
 
+class _Forgetful(dict):
+    """A probe cache that keeps nothing: the set-up before the probe was cached (every episode recompiled it)."""
+
+    def __setitem__(self, key, value) -> None:
+        pass
+
+
+def reset_paired(n: int, repeat: int, suite: str = "auv-track-v2", task: str = "lawnmower",
+                 tier: str = "design") -> dict:
+    """Paired cold-reset times of N envs: the plug-in probe recompiled per episode (before) and cached (now).
+
+    Parameters
+    ----------
+    n : int
+        Environments.
+    repeat : int
+        Pairs (median of the per-pair ratios reported).
+    suite, task, tier : str, optional
+        The cell.
+
+    Returns
+    -------
+    dict
+        ``before_s``, ``now_s`` (medians) and ``ratio`` (median of before / now over the pairs).
+    """
+    from auvtrack.control import plugin
+    from auvtrack.gym.vector import TrackVectorEnv
+
+    TrackVectorEnv(n, suite, task, tier).reset(seed=10**6)
+    cached = plugin._PROBED
+    before, now, ratios = [], [], []
+    for r in range(repeat):
+        times = []
+        for mode, seed in (("before", 2 * 10**7 * (r + 1)), ("now", 2 * 10**7 * (r + 1) + 10**6)):
+            plugin._PROBED = _Forgetful() if mode == "before" else cached
+            venv = TrackVectorEnv(n, suite, task, tier)
+            t0 = time.perf_counter()
+            venv.reset(seed=seed)
+            times.append(time.perf_counter() - t0)
+        plugin._PROBED = cached
+        before.append(times[0])
+        now.append(times[1])
+        ratios.append(times[0] / times[1])
+    return {"num_envs": n, "before_s": round(statistics.median(before), 4), "now_s": round(statistics.median(now), 4),
+            "ratio": round(statistics.median(ratios), 2), "repeat": repeat,
+            "before": "the replay law's bounds-checked probe compiled at every episode's set-up (commit 7de3f7a)"}
+
+
 def main() -> None:
     """Measure and write the JSON record."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -72,6 +120,7 @@ def main() -> None:
     ap.add_argument("--reset-sizes", default="1,64,256")
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--paired-envs", type=int, default=8, help="N of the paired before/now reset timing (0: skip)")
     ap.add_argument("--out", default=str(HERE / "gym_throughput.json"))
     args = ap.parse_args()
     from auvtrack.perf.bench import machine
@@ -82,6 +131,7 @@ def main() -> None:
     t0 = time.perf_counter()
     doc = bench_gym(sizes=sizes, repeat=args.repeat, steps=args.steps)
     doc["reset"] = reset_rows(tuple(int(s) for s in args.reset_sizes.split(",") if s), args.repeat)
+    doc["reset_paired"] = reset_paired(args.paired_envs, args.repeat) if args.paired_envs else None
     doc["load_avg_before"] = before
     doc["load_avg_end"] = machine()["load_avg_1_5_15"]
     doc["seconds"] = round(time.perf_counter() - t0, 1)
@@ -93,6 +143,9 @@ def main() -> None:
         print(f"N={r['num_envs']:5d}: {r['env_steps_per_s']:>12,.0f} env steps/s  (x{r['ratio_to_batch']} of batch)")
     for r in doc["reset"]:
         print(f"reset N={r['num_envs']:5d}: cold {r['cold_s']:.3f} s ({r['cold_ms_per_env']} ms/env), warm {r['warm_s']} s")
+    if doc["reset_paired"]:
+        p = doc["reset_paired"]
+        print(f"reset N={p['num_envs']} paired: before {p['before_s']} s, now {p['now_s']} s, x{p['ratio']}")
     print(f"load {before} -> {doc['load_avg_end']}; written {args.out}")
 
 
