@@ -91,7 +91,14 @@ def load(law: str) -> tuple[Any, ControllerSpec]:
         mod = load_module(law)
     except Exception as exc:  # any error raised while importing the user's file
         raise ValueError(f"cannot import {law}: {first_line(exc)}") from None
-    return mod, dataclasses.replace(check_controller(mod, plugin=True), module=law)
+    key = (mod, law)
+    if key not in _SPECS:  # checked once per imported module (a set-up per episode reuses the record)
+        _SPECS[key] = dataclasses.replace(check_controller(mod, plugin=True), module=law)
+    return mod, _SPECS[key]
+
+
+_SPECS: dict = {}
+"""The checked record of each (imported plug-in module, ``controller.module``) (:func:`load`)."""
 
 
 def spec_of(section: "Params") -> ControllerSpec:
