@@ -11,14 +11,22 @@ random actions drawn before timing, medians over ``--repeat`` timings of ``--ste
 the ratio of the env's RK4 steps/s to the batch runner's on the same episodes.  The reset rows
 time :meth:`~auvtrack.gym.vector.TrackVectorEnv.reset` of N envs on seed indices not seen before
 (``cold``: every episode prepared) and on the same indices again (``warm``: the prepared rows
-kept), medians over ``--repeat``.  The load average is recorded before and after: on a shared
-machine the numbers move with it.  The issue's target is 300 000 env steps/s at N = 1024.
+kept), medians over ``--repeat``.  ``reset_paired`` alternates the set-up before the plug-in probe
+was cached and now in one process; ``paired_against_revision`` alternates fresh processes running the
+code of ``--against`` (default the branch point, 7de3f7a) and this tree on a cold reset and on an
+episode loop (episodes of 10 env steps, autoreset preparing a new seed index per episode): medians
+and the median paired ratio.  The load average is recorded before and after: on a shared machine
+the numbers move with it.  The issue's target is 300 000 env steps/s at N = 1024.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -113,6 +121,93 @@ def reset_paired(n: int, repeat: int, suite: str = "auv-track-v2", task: str = "
             "before": "the replay law's bounds-checked probe compiled at every episode's set-up (commit 7de3f7a)"}
 
 
+def child_measure(task: str, n: int, seed: int, steps: int) -> float:
+    """One timing in this process (the ``--child`` mode): seconds of a cold reset, or env steps/s of a loop.
+
+    Parameters
+    ----------
+    task : str
+        ``"reset"``: a reset of N envs on new seed indices; ``"loop"``: ``steps`` env steps of N envs
+        with episodes of 10 env steps (0.2 s), autoreset preparing a new seed index per episode.
+    n : int
+        Environments.
+    seed : int
+        Seed index of env 0 (new indices for every timing).
+    steps : int
+        Env steps of the loop.
+
+    Returns
+    -------
+    float
+        Seconds (reset) or env steps/s (loop).
+    """
+    import numpy as np
+
+    from auvtrack.gym.vector import TrackVectorEnv
+
+    duration = 0.2 if task == "loop" else None
+    TrackVectorEnv(1, "auv-track-v2", "lawnmower", "design", duration=duration).reset(seed=10**9)  # compile/load
+    venv = TrackVectorEnv(n, "auv-track-v2", "lawnmower", "design", duration=duration)
+    if task == "reset":
+        t0 = time.perf_counter()
+        venv.reset(seed=seed)
+        return time.perf_counter() - t0
+    acts = np.random.default_rng(0).uniform(-1, 1, (steps, n, 3))
+    t0 = time.perf_counter()
+    venv.reset(seed=seed)
+    for k in range(steps):
+        venv.step(acts[k])
+    return n * steps / (time.perf_counter() - t0)
+
+
+def paired_against(rev: str, task: str, n: int, steps: int, repeat: int) -> dict:
+    """Paired timings of ``task`` (:func:`child_measure`) with the code of git revision ``rev`` and with this tree.
+
+    Each pair runs two fresh processes, the revision's then this tree's, on the same new seed
+    indices; the ratio is this tree's speed over the revision's (median over the pairs).
+
+    Parameters
+    ----------
+    rev : str
+        A git revision (its tree is exported with ``git archive`` to a temporary folder).
+    task : str
+        ``"reset"`` or ``"loop"``.
+    n, steps, repeat : int
+        Environments, loop steps, pairs.
+
+    Returns
+    -------
+    dict
+        The medians of both, the median paired ratio and the revision.
+    """
+    root = HERE.parent
+    commit = subprocess.run(["git", "-C", str(root), "rev-parse", rev], capture_output=True, text=True,
+                            check=True).stdout.strip()
+    with tempfile.TemporaryDirectory() as tmp:
+        archive = subprocess.run(["git", "-C", str(root), "archive", commit, "auvtrack"], capture_output=True,
+                                 check=True).stdout
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+
+        def one(tree: str, seed: int) -> float:
+            env = {**os.environ, "PYTHONPATH": tree}
+            out = subprocess.run([sys.executable, __file__, "--child", task, "--child-n", str(n), "--child-seed",
+                                  str(seed), "--steps", str(steps)], capture_output=True, text=True, env=env,
+                                 check=True, cwd=tree)
+            return float(out.stdout.strip().splitlines()[-1])
+
+        before, now, ratios = [], [], []
+        for r in range(repeat):
+            seed = 3 * 10**7 * (r + 1)
+            b, c = one(tmp, seed), one(str(root), seed)
+            before.append(b)
+            now.append(c)
+            ratios.append(b / c if task == "reset" else c / b)
+    unit = "s" if task == "reset" else "env_steps_per_s"
+    return {"task": task, "num_envs": n, "steps": steps if task == "loop" else None, "unit": unit,
+            "before": round(statistics.median(before), 4), "now": round(statistics.median(now), 4),
+            "speedup": round(statistics.median(ratios), 2), "repeat": repeat, "before_rev": commit}
+
+
 def main() -> None:
     """Measure and write the JSON record."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -122,7 +217,18 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=50)
     ap.add_argument("--paired-envs", type=int, default=8, help="N of the paired before/now reset timing (0: skip)")
     ap.add_argument("--out", default=str(HERE / "gym_throughput.json"))
+    ap.add_argument("--against", default="7de3f7a",
+                    help="git revision for the paired reset / episode-loop timings ('' to skip)")
+    ap.add_argument("--paired-n", type=int, default=16, help="N of the paired timings against --against")
+    ap.add_argument("--paired-steps", type=int, default=30, help="env steps of the paired episode loop")
+    ap.add_argument("--paired-repeat", type=int, default=3, help="pairs of the timings against --against")
+    ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
+    ap.add_argument("--child-n", type=int, default=1, help=argparse.SUPPRESS)
+    ap.add_argument("--child-seed", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.child:
+        print(child_measure(args.child, args.child_n, args.child_seed, args.steps))
+        return
     from auvtrack.perf.bench import machine
     from auvtrack.perf.gym_bench import bench_gym
 
@@ -132,11 +238,14 @@ def main() -> None:
     doc = bench_gym(sizes=sizes, repeat=args.repeat, steps=args.steps)
     doc["reset"] = reset_rows(tuple(int(s) for s in args.reset_sizes.split(",") if s), args.repeat)
     doc["reset_paired"] = reset_paired(args.paired_envs, args.repeat) if args.paired_envs else None
+    doc["paired_against_revision"] = [] if not args.against else [
+        paired_against(args.against, "reset", args.paired_n, 0, args.paired_repeat),
+        paired_against(args.against, "loop", args.paired_n, args.paired_steps, args.paired_repeat)]
     doc["load_avg_before"] = before
     doc["load_avg_end"] = machine()["load_avg_1_5_15"]
     doc["seconds"] = round(time.perf_counter() - t0, 1)
     doc["command"] = "python benchmarks/gym_throughput.py " + " ".join(
-        f"--{k.replace('_', '-')} {v}" for k, v in vars(args).items() if k != "out")
+        f"--{k.replace('_', '-')} {v}" for k, v in vars(args).items() if k != "out" and not k.startswith("child"))
     doc["target_env_steps_per_s_at_1024"] = 300_000
     Path(args.out).write_text(json.dumps(doc, indent=2) + "\n")
     for r in doc["rows"]:
@@ -146,6 +255,9 @@ def main() -> None:
     if doc["reset_paired"]:
         p = doc["reset_paired"]
         print(f"reset N={p['num_envs']} paired: before {p['before_s']} s, now {p['now_s']} s, x{p['ratio']}")
+    for p in doc["paired_against_revision"]:
+        print(f"{p['task']} N={p['num_envs']} vs {p['before_rev'][:7]}: before {p['before']}, now {p['now']} "
+              f"({p['unit']}), x{p['speedup']}")
     print(f"load {before} -> {doc['load_avg_end']}; written {args.out}")
 
 
