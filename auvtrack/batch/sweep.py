@@ -207,6 +207,48 @@ def _client(workers: int | None, scheduler: str | None, memory_limit: str | int)
     return client, cluster
 
 
+KERNEL_KEYS = ("controller", "plant")
+"""Sections whose grid values may change a sample's kernel (the law, the plant)."""
+
+
+def study_kernels(spec: SweepSpec) -> list:
+    """One prepared sample per kernel the study's grid may use, for compiling them before the workers start.
+
+    The built-in kernels are what a worker's warm-up loads; a study may fly others (a ``policy``, a
+    plug-in law, a 6-DOF preset), which each worker would otherwise compile on its first sample.
+    One grid point is prepared per distinct combination of the grid's ``controller.*`` and
+    ``plant.*`` values (its first sample that the scenario accepts).
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The study.
+
+    Returns
+    -------
+    list of Prepared
+        The prepared samples (their ``key`` is the kernel), one per combination that prepares.
+    """
+    from ..scenario import load_scenario
+    from ..simulation.pipeline import prepare
+
+    keys = [k for k in spec.study.grid if k.split(".", 1)[0] in KERNEL_KEYS]
+    seen, preps = set(), []
+    for point in range(spec.study.n_points):
+        first = point * spec.study.samples
+        combo = tuple(json.dumps(spec.sample(first)[2][k], sort_keys=True, default=str) for k in keys)
+        if combo in seen:
+            continue
+        for index in range(first, first + spec.study.samples):
+            try:
+                preps.append(prepare(load_scenario(spec.base, spec.overrides(index)[1])))
+            except ValueError:  # ScenarioError is one
+                continue  # an invalid draw: the next replicate of the point
+            seen.add(combo)
+            break
+    return preps
+
+
 def run_sweep(study: str | Path | SweepSpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, resume: bool = False, max_chunks: int | None = None,
               progress: bool = True, client: Any = None, memory_limit: str | int = DEFAULT_WORKER_MEMORY,
@@ -259,10 +301,13 @@ def run_sweep(study: str | Path | SweepSpec, out: str | Path, *, workers: int | 
     parse_memory(memory_limit)
     cluster = None if client is not None or scheduler else (lambda: _client(workers, None, memory_limit))
     if cluster is not None:  # local workers load the kernels from the disk cache: compile them here, visibly
-        from ..simulation.compiling import warmup
+        from ..simulation.compiling import ensure_compiled, warmup
 
-        # what each worker's warm-up loads (sweep_worker.worker_warmup); without progress, silently
-        warmup(progress=progress, notice=None if progress else (lambda text: None))
+        # what each worker's warm-up loads (sweep_worker.worker_warmup), then the study's own kernels (a
+        # policy, a plug-in); without progress, silently
+        quiet = None if progress else (lambda text: None)
+        warmup(progress=progress, notice=quiet)
+        ensure_compiled(study_kernels(spec), progress=progress, notice=quiet)
     res = execute_chunks(SweepJob(spec), out, resume=resume, client=client, scheduler=scheduler,
                          start_cluster=cluster, max_chunks=max_chunks, progress=progress, on_chunk=on_chunk)
     summary = None

@@ -49,7 +49,10 @@ class _StudyCommand(click.Command):
               help="ablation: one pulse direction (N, N, N, N m, N m per unit amplitude) instead of the defaults.")
 @click.option("--pulse-start", "pulse_start", type=float, default=None, metavar="T",
               help="ablation: pulse onset in s (default 20; the run lasts until T + 20 s).")
-def study(name: str, out: str | None, quick: bool, pulse: str | None, pulse_start: float | None) -> None:
+@click.option("--controllers", default=None, metavar="KIND,KIND",
+              help="model-gap: the controllers to fly (default every built-in tracking controller; e.g. policy,pid).")
+def study(name: str, out: str | None, quick: bool, pulse: str | None, pulse_start: float | None,
+          controllers: str | None) -> None:
     """Run study NAME and write report.md, report.html, results.json and figures/ (NAME 'list': list them)."""
     from ..studies.registry import all_studies, get_study, run_study
 
@@ -61,10 +64,18 @@ def study(name: str, out: str | None, quick: bool, pulse: str | None, pulse_star
         spec = get_study(name)
     except KeyError as e:
         raise BadInput(str(e.args[0])) from None
-    options = {k: v for k, v in (("pulse", pulse), ("pulse_start", pulse_start)) if v is not None}
+    kinds = None if controllers is None else controllers.split(",")
+    options = {k: v for k, v in (("pulse", pulse), ("pulse_start", pulse_start), ("controllers", kinds)) if v is not None}
     for k in options:
         if k not in spec.options:
             raise BadInput(f"--{k.replace('_', '-')}: not an option of study {name!r}")
+    if kinds is not None:
+        from ..studies.model_gap import check_kinds
+
+        try:
+            options["controllers"] = check_kinds(kinds)
+        except ValueError as exc:
+            raise BadInput(str(exc)) from None
     report = run_study(spec, Path(out) if out else Path("studies") / name, quick=quick, progress=True, **options)
     html = report.with_suffix(".html")
     click.echo(f"report: {report}" + (f", {html}" if html.exists() else ""))

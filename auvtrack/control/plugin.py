@@ -91,7 +91,14 @@ def load(law: str) -> tuple[Any, ControllerSpec]:
         mod = load_module(law)
     except Exception as exc:  # any error raised while importing the user's file
         raise ValueError(f"cannot import {law}: {first_line(exc)}") from None
-    return mod, dataclasses.replace(check_controller(mod, plugin=True), module=law)
+    key = (mod, law)
+    if key not in _SPECS:  # checked once per imported module (a set-up per episode reuses the record)
+        _SPECS[key] = dataclasses.replace(check_controller(mod, plugin=True), module=law)
+    return mod, _SPECS[key]
+
+
+_SPECS: dict = {}
+"""The checked record of each (imported plug-in module, ``controller.module``) (:func:`load`)."""
 
 
 def spec_of(section: "Params") -> ControllerSpec:
@@ -178,6 +185,10 @@ def _check_compiled(cc: Any, spec: ControllerSpec, law: str) -> CompiledControll
     return dataclasses.replace(cc, aux_names=tuple(cc.aux_names), **arrays)
 
 
+_PROBED: dict = {}
+"""A law's bounds-checked probe copy (:func:`_probe`), by the law's dispatcher."""
+
+
 def _probe(mod, law: str, cc: CompiledController, ctx: SetupContext) -> None:
     """Run the law once at the initial state, compiled with bounds checking: an int status, no bad index."""
     from numba import njit as numba_njit
@@ -188,7 +199,9 @@ def _probe(mod, law: str, cc: CompiledController, ctx: SetupContext) -> None:
 
     from ..interrupt import run_in_thread
 
-    checked = numba_njit(boundscheck=True, nogil=True)(mod.control.py_func)
+    checked = _PROBED.get(mod.control)
+    if checked is None:  # compiled once per law and process: a set-up per episode does not recompile it
+        checked = _PROBED[mod.control] = numba_njit(boundscheck=True, nogil=True)(mod.control.py_func)
     try:
         outcome = run_in_thread(lambda: evaluate(checked, 0.0, ctx.eta0, ctx.nu0, cc.xc0, ctx.refm0, cc.cp,
                                                  ctx.vp_nom, n_aux=len(cc.aux_names)))

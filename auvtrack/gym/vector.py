@@ -5,9 +5,10 @@ Rows of the engine's :class:`~auvtrack.engine.loop.Stacked` inputs and of the
 replay tables and calls the step module's ``step_all`` once.  Autoreset follows Gymnasium's
 default (``NEXT_STEP``): the step after an env ended resets it (seed index drawn from the vector
 env's generator) and returns its first observation with reward 0; with ``autoreset="disabled"``
-an ended env stays ended (not stepped, reward 0) until :meth:`reset`.  A reset prepares that env's
-run in Python (once per seed index: the prepared rows are kept for the next episode of that index);
-the step itself runs no per-env Python.  At an episode's end ``info`` carries its benchmark
+an ended env stays ended (not stepped, reward 0) until :meth:`reset`.  A reset prepares each new
+seed index's run in Python (the prepared rows are kept for the next episode of that
+index) and copies the rows of all the envs it resets in one assignment per array; the step itself
+runs no per-env Python.  At an episode's end ``info`` carries its benchmark
 metrics (``info["metrics"]``, ``info["status"]``, ``info["t"]``, object arrays, with the masks
 ``info["_metrics"]`` ... of the envs that ended, Gymnasium's vector-info convention).
 """
@@ -78,20 +79,28 @@ class TrackVectorEnv(VectorEnv):
                                      tuple(self.one.prep.scenario.metrics.window))
         return self._prepared[index]
 
-    def _load(self, i: int, index: int) -> None:
-        """Prepare env ``i`` for seed index ``index`` and copy its rows in."""
-        one_ins, one_c, window = self._rows(index)
+    def _load(self, envs: np.ndarray, indices: list[int]) -> None:
+        """Prepare envs ``envs`` for seed indices ``indices`` and copy their rows in, one array at a time.
+
+        Each new seed index is prepared once in Python (:meth:`_rows`); the copy is one
+        assignment per input and carry array for all the envs at once, not one per env.
+        """
+        envs = np.asarray(envs, dtype=np.int64)
+        if envs.size == 0:
+            return
+        made = [self._rows(int(index)) for index in indices]
         if self.ins is None:
+            one_ins, one_c, _ = made[0]
             self.ins = type(one_ins)(*[np.repeat(a, self.num_envs, axis=0) for a in one_ins])
             self.carry = new_carry(self.num_envs, one_c.xp.shape[1], one_c.xc.shape[1], one_c.cmd.shape[1],
                                    one_c.obs.shape[1])
             self.kernels = self.one.kernels
-        for dst, src in zip(self.ins, one_ins):
-            dst[i] = src[0]
-        for dst, src in zip(self.carry, one_c):
-            dst[i] = src[0]
-        self.seed_indices[i] = index
-        self.windows[i] = window
+        for j, dst in enumerate(self.ins):
+            dst[envs] = np.concatenate([m[0][j] for m in made]) if len(made) > 1 else made[0][0][j]
+        for j, dst in enumerate(self.carry):
+            dst[envs] = np.concatenate([m[1][j] for m in made]) if len(made) > 1 else made[0][1][j]
+        self.seed_indices[envs] = indices
+        self.windows[envs] = [m[2] for m in made]
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
         """Reset every env: seed indices ``seed + i`` (or the given list, or drawn).
@@ -117,8 +126,7 @@ class TrackVectorEnv(VectorEnv):
         self._np_random, _ = gym.utils.seeding.np_random(None if seed is None else seeds[0])
         if seeds is None:
             seeds = [int(s) for s in self._np_random.integers(0, 2**31 - 1, self.num_envs)]
-        for i, s in enumerate(seeds):
-            self._load(i, s)
+        self._load(np.arange(self.num_envs), seeds)
         self._done[:] = False
         return self.carry.obs.copy(), {"seed_index": self.seed_indices.copy()}
 
@@ -142,8 +150,8 @@ class TrackVectorEnv(VectorEnv):
         c, ins = self.carry, self.ins
         ended = np.flatnonzero(self._done)
         if self.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP:
-            for i in ended:  # these envs start a new episode now
-                self._load(int(i), int(self._np_random.integers(0, 2**31 - 1)))
+            # these envs start a new episode now (one seed index drawn per env, in env order)
+            self._load(ended, [int(self._np_random.integers(0, 2**31 - 1)) for _ in ended])
         ctrl_every = ins.si[:, SI.ctrl_every]
         rows = np.minimum(c.ks[:, 0] // ctrl_every, ins.cp[:, GAINS.n].astype(np.int64) - 1)
         cols = GAINS.table + 3 * rows[:, None] + np.arange(3)[None, :]

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -77,6 +78,39 @@ def controllers() -> list[str]:
     """Tracking controllers to compare: every built-in whose registration says it tracks (no plug-ins)."""
     from ..benchmark.suite import tracking_kinds
     return tracking_kinds()
+
+
+_every_controller = controllers  # run()'s default, under a name its ``controllers`` argument does not hide
+
+
+def check_kinds(kinds: Sequence[str]) -> list[str]:
+    """The controllers a run of the study flies (``--controllers``): registered kinds that track a reference.
+
+    Parameters
+    ----------
+    kinds : sequence of str
+        ``controller.kind`` values, e.g. ``["policy", "pid"]`` (a learned policy flies its default
+        file, :data:`auvtrack.control.policy.DEFAULT_POLICY`).
+
+    Returns
+    -------
+    list of str
+        The kinds, in order, without repeats.
+
+    Raises
+    ------
+    ValueError
+        An empty list, or a kind that is not registered or does not track (one line naming the choices).
+    """
+    from ..control import CONTROLLERS
+
+    out = list(dict.fromkeys(k.strip() for k in kinds if k.strip()))
+    allowed = [k for k, spec in CONTROLLERS.items() if spec.tracks]
+    bad = [k for k in out if k not in allowed]
+    if not out or bad:
+        raise ValueError(f"--controllers: {'no controller given' if not out else 'unknown or open-loop ' + ', '.join(bad)} "
+                         f"(choose from {', '.join(allowed)})")
+    return out
 
 
 def start_pose(ref_spec: dict, ell: float = ELL) -> tuple[list[float], list[float]]:
@@ -147,12 +181,12 @@ def gain_sets(controller: str) -> tuple[str, ...]:
     return GAINS if designable(controller) else GAINS[:1]
 
 
-def jobs(quick: bool) -> list[tuple]:
-    """Every (controller, truth, reference, current, gains) of the study."""
+def jobs(quick: bool, kinds: Sequence[str] | None = None) -> list[tuple]:
+    """Every (controller, truth, reference, current, gains) of the study (``kinds``: default :func:`controllers`)."""
     refs = ("helix",) if quick else tuple(REFERENCES)
     currents = (False,) if quick else (False, True)
-    return [(k, t, r, c, g) for k in controllers() for g in gain_sets(k) for t in TRUTHS for r in refs
-            for c in currents]
+    return [(k, t, r, c, g) for k in (controllers() if kinds is None else kinds) for g in gain_sets(k) for t in TRUTHS
+            for r in refs for c in currents]
 
 
 def feasibility(truth: str, reference: str, current: bool, duration: float):
@@ -216,7 +250,7 @@ def summarise(job: tuple, res, limits: dict | None) -> dict:
     return row
 
 
-def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
+def run(out: Path, *, quick: bool = False, progress: bool = False, controllers: Sequence[str] | None = None) -> Path:
     """Run the model-gap study and write ``report.md``, ``results.json`` and ``runs.csv``.
 
     Parameters
@@ -228,6 +262,9 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
         current, 150 s.
     progress : bool, optional
         Show a progress bar.
+    controllers : sequence of str, optional
+        The controller kinds to fly (:func:`check_kinds`; ``auvtrack study model-gap --controllers
+        policy,pid``); default every built-in tracking controller.
 
     Returns
     -------
@@ -238,15 +275,16 @@ def run(out: Path, *, quick: bool = False, progress: bool = False) -> Path:
     from ..simulation.compiling import compile_first
     from ..simulation.pipeline import prepare, run_prepared
 
-    compile_first([(c, p) for c in controllers() for p in ("5dof", "6dof")], progress=progress)
+    kinds = _every_controller() if controllers is None else check_kinds(controllers)
+    compile_first([(c, p) for c in kinds for p in ("5dof", "6dof")], progress=progress)
     out = Path(out)
     duration = 20.0 if quick else 150.0
     tasks = {}
-    for _, truth, ref, current, _ in jobs(quick):
+    for _, truth, ref, current, _ in jobs(quick, kinds):
         if (truth, ref, current) not in tasks:
             tasks[truth, ref, current] = feasibility(truth, ref, current, duration)
     rows = []
-    for job in tqdm(jobs(quick), disable=not progress, desc="model-gap"):
+    for job in tqdm(jobs(quick, kinds), disable=not progress, desc="model-gap"):
         kind, truth, ref, current, gains = job
         f = tasks[truth, ref, current]
         if f.verdict == "infeasible":
@@ -333,4 +371,4 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
 
 STUDY = StudySpec("model-gap", run, "controllers designed on the 5-DOF REMUS 100 flown on 6-DOF truth "
                   "models (Prestero, Fossen), designed and published gains: failures by cause, tracking, "
-                  "distance to the path, actuator usage")
+                  "distance to the path, actuator usage", options=("controllers",))

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .truth_presets import load_preset6
+from .truth_presets import preset6_values
 
 SOURCE_6DOF = "remus100_prestero"
 U0_MIN, U0_MAX = 0.05, 3.0  # m/s: the range a linearisation speed may take
@@ -45,7 +45,7 @@ def reduce_prestero(u0: float) -> dict:
     """
     if not (isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX):
         raise ValueError(f"vehicle.u0: must be a speed in [{U0_MIN}, {U0_MAX}] m/s (got {u0!r})")
-    v = load_preset6(SOURCE_6DOF).values
+    v = preset6_values(SOURCE_6DOF)
     m = v["mass.W"] / v["mass.g"]
     mm = (m - v["added_mass.X_udot"], m - v["added_mass.Y_vdot"], m - v["added_mass.Z_wdot"],
           v["mass.Iyy"] - v["added_mass.M_qdot"], v["mass.Izz"] - v["added_mass.N_rdot"])

@@ -17,8 +17,10 @@ import copy
 import functools
 import math
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
+from types import MappingProxyType
 
 SHIPPED6: tuple[str, ...] = ("remus100_prestero", "remus100_fossen")
 SHIPPED_FILES6: tuple[str, ...] = ("remus600",)  # Fossen-type vehicle files of other vehicles
@@ -102,3 +104,20 @@ def load_preset6(name: str) -> Preset6:
             values[f"{section}.{key}"] = _number(section, key, e["value"])
     return Preset6(name=raw["name"], description=raw.get("description", ""), values=values,
                    record=record)
+
+
+@functools.lru_cache(maxsize=None)
+def preset6_values(name: str) -> Mapping[str, float | tuple[float, ...]]:
+    """The checked values of a 6-DOF preset, read once per process (read-only).
+
+    Parameters
+    ----------
+    name : str
+        ``"remus100_prestero"`` or ``"remus100_fossen"``.
+
+    Returns
+    -------
+    Mapping
+        :func:`load_preset6` ``(name).values`` (numbers and tuples of numbers), not to be modified.
+    """
+    return MappingProxyType(load_preset6(name).values)

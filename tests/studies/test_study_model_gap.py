@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -76,3 +77,38 @@ def test_designed_defaults_track_every_calm_truth_run_to_half_a_metre(kind, trut
     res = run_prepared(prepare(sc))
     assert res.ok, res.failure
     assert res.metrics["xtrack_rmse"] <= 0.5
+
+
+def test_a_learned_policy_flies_the_study(tmp_path):
+    """``controllers=["policy"]``: the rows are the shipped policy flown on each truth, each equal bit for bit
+    to a direct run of the same scenario, and not what a built-in law flies there."""
+    mg.run(tmp_path, quick=True, controllers=["policy"])
+    rows = json.loads((tmp_path / "results.json").read_text())["rows"]
+    assert {(r["controller"], r["truth"], r["gains"]) for r in rows} == {("policy", t, "designed") for t in mg.TRUTHS}
+    flown = [r for r in rows if r["status"] != "infeasible"]
+    assert flown and any(r["truth"] != "5dof" for r in flown)  # a 6-DOF truth too, through the allocation
+    for r in flown:
+        prep = prepare(load_scenario(mg.scenario("policy", r["truth"], "helix", False, 20.0)))
+        assert prep.key.law == "auvtrack.control.policy"
+        res = run_prepared(prep)
+        assert r["status"] == res.status
+        assert r["xtrack_rmse_late"] == res.metrics["xtrack_rmse"] and r["t_sat_tau_u"] == res.metrics["t_sat_tau_u"]
+        other = run_prepared(prepare(load_scenario(mg.scenario("ftsmc", r["truth"], "helix", False, 20.0))))
+        assert other.metrics["xtrack_rmse"] != res.metrics["xtrack_rmse"]
+
+
+def test_controllers_option_is_checked_on_the_command_line(monkeypatch, tmp_path, capsys):
+    from auvtrack.cli import main
+    from auvtrack.studies import registry
+
+    calls = []
+    spec = registry.StudySpec("model-gap", lambda out, **kw: calls.append(kw) or Path(out) / "report.md", "",
+                              options=("controllers",))
+    monkeypatch.setattr(registry, "get_study", lambda name: spec)
+    assert main(["study", "model-gap", "--out", str(tmp_path), "--controllers", "policy, pid,policy"]) == 0
+    assert calls[-1]["controllers"] == ["policy", "pid"]
+    for bad, expect in (("nope", "unknown or open-loop nope"), (",", "no controller given")):
+        assert main(["study", "model-gap", "--out", str(tmp_path), "--controllers", bad]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and expect in err and "policy" in err, err
+    assert mg.STUDY.options == ("controllers",)
