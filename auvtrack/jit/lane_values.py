@@ -464,21 +464,33 @@ def _gather(context, builder, sig, args):
 
 
 def _lane_positions(context, builder, aryty, ary, idxs, tys):
-    """Element offsets (in scalars, lane 0 of the element) of each lane's index, and whether all are equal."""
+    """Element offsets (in scalars, lane 0 of the element) of each lane's index, and whether all are equal.
+
+    The offsets are computed as one integer vector (the row-major flat index of each lane times the
+    lane count) and compared with lane 0's in one vector comparison; the per-lane offsets are its
+    elements.  Only the address arithmetic is vectorised: every lane loads (or stores) the element
+    it indexed before, so the values are unchanged.
+    """
     lanes = aryty.dtype
     base = builder.bitcast(ary.data, context.get_value_type(lanes.dtype).as_pointer())
     shape = cgutils.unpack_tuple(builder, ary.shape)
-    L = context.get_constant(types.intp, lanes.count)
-    pos = []
-    for k in range(lanes.count):
-        flat = context.get_constant(types.intp, 0)
-        for i, (v, t) in enumerate(zip(idxs, tys)):
-            x = _lane(builder, v, k) if isinstance(t, Lanes) else context.cast(builder, v, t, types.intp)
-            flat = builder.add(builder.mul(flat, shape[i]), x) if i else x
-        pos.append(builder.mul(flat, L))
-    same = ir.Constant(ir.IntType(1), 1)
-    for k in range(1, lanes.count):
-        same = builder.and_(same, builder.icmp_signed("==", pos[k], pos[0]))
+    intp = context.get_value_type(types.intp)
+    vty = ir.VectorType(intp, lanes.count)
+
+    def vec(v, t):
+        if isinstance(t, Lanes):
+            return v if v.type == vty else builder.sext(v, vty)
+        return _broadcast(builder, context.cast(builder, v, t, types.intp), vty, lanes.count)
+
+    flat = None
+    for i, (v, t) in enumerate(zip(idxs, tys)):
+        x = vec(v, t)
+        flat = x if flat is None else builder.add(builder.mul(flat, _broadcast(builder, shape[i], vty, lanes.count)), x)
+    pos_v = builder.mul(flat, ir.Constant(vty, [lanes.count] * lanes.count))
+    first = builder.shuffle_vector(pos_v, pos_v, ir.Constant(ir.VectorType(ir.IntType(32), lanes.count),
+                                                             [0] * lanes.count))
+    same = _vcall(builder, "llvm.vector.reduce.and", [builder.icmp_signed("==", pos_v, first)], ir.IntType(1))
+    pos = [builder.extract_element(pos_v, _i32(k)) for k in range(lanes.count)]
     return base, pos, same
 
 
