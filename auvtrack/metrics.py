@@ -200,11 +200,15 @@ def _path_add(acc, off, dt, y_e, z_e, along):
 def path_update(acc, t, dt, p, path, t0, t1, t_late):
     """Project the navigation point on the path and add the step to the path-following sums.
 
-    The projection (:func:`auvtrack.reference.path.project`) runs at every step, inside the window
-    or not, from the previous step's path parameter (the time ``t`` at the first step), within
-    :data:`PATH_WINDOW` of it, starting from the path point the previous step found there (kept in
-    the accumulator: the same numbers as evaluating it again, one evaluation fewer); the cross-track, vertical-track and along-track errors are then
-    accumulated over the window ``[t0, t1)`` and over its second half ``t >= t_late``.
+    The projection (:func:`auvtrack.reference.path.project`) runs at every step up to the end of
+    the window, before it too, from the previous step's path parameter (the time ``t`` at the first
+    step), within :data:`PATH_WINDOW` of it, starting from the path point the previous step found
+    there (kept in the accumulator: the same numbers as evaluating it again, one evaluation fewer);
+    the cross-track, vertical-track and along-track errors are then accumulated over the window
+    ``[t0, t1)`` and over its second half ``t >= t_late``.  Each projection is warm-started from the
+    previous one, so the steps before ``t0`` are projected for the answers inside the window to be
+    those of the chain from the first step; a step at or after ``t1`` is not projected at all: its
+    answer would only warm-start later steps, which are outside the window too.
 
     Parameters
     ----------
@@ -221,6 +225,9 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
     t_late : float
         Start of the window's second half (s).
     """
+    tol = TOL_FRACTION * dt
+    if t >= t1 - tol:  # after the window (the rule of metrics_update): nothing to add or to warm-start
+        return
     guess = acc[OFF_PATH_S]
     if math.isnan(guess):
         s, pt = project(path, t, p, PATH_WINDOW)
@@ -232,8 +239,7 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
     for i in range(3):
         for j in range(3):
             acc[OFF_PATH_PT + 3 * i + j] = pt[i][j]
-    tol = TOL_FRACTION * dt
-    if t < t0 - tol or t >= t1 - tol:
+    if t < t0 - tol:
         return
     e = path_errors(pt, p)
     along = along_track_error(pt, s, t)

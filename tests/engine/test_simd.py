@@ -293,6 +293,18 @@ def test_simd_batch_equals_single_runs_with_failures_at_different_times(kind):
         assert {r.status for r in singles} == {"ok", "failed"}
 
 
+
+def test_simd_batch_with_metric_windows_ending_at_different_times_equals_single_runs():
+    """The path-following metrics of lanes whose metric windows start and end at different steps (a lane
+    stops projecting at the end of its window while the others go on), bit for bit those of single runs."""
+    cases = [{"controller.kind": "fxtntsmc", "seed": i, "sim.duration": 0.6,
+              "metrics.window": [0.02 * i, 0.15 + 0.04 * i]} for i in range(L)]
+    preps = [prepare(load_scenario(PAPER, c)) for c in cases]
+    singles = [run_prepared(p) for p in preps]
+    for s, r in zip(run_batch(preps, backend="simd", workers=2), singles):
+        _same_run(s, r, bitwise=True)
+        assert math.isfinite(r.metrics["xtrack_rmse"]) and math.isfinite(r.metrics["along_rmse_late"])
+
 def test_simd_batch_on_the_6dof_plants_equals_single_runs():
     """Both 6-DOF preset modules (Prestero, Fossen) in lanes: a tracking law with noise, sampled-data
     control and a current, roll limits that stop lanes at different times, and the open-loop actuator
