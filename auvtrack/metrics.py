@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from .jit import njit, njit_noalloc
+from .jit.lane_values import lane_at, lane_column, lane_count
 from .reference.path import SPEED2_MIN, along_track_error, path_errors, project, project_from
 
 AXES = ("x", "y", "z")
@@ -247,6 +248,39 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
     if t >= t_late - tol:
         _path_add(acc, OFF_PATH_LATE, dt, e[1], e[2], along)
 
+
+@njit_noalloc(inline="always")
+def path_update_lanes(acc, t, dt, p, path, t0, t1, t_late, m):
+    """Lane form of :func:`path_update` (SIMD batch): the scalar function once per lane of the mask ``m``.
+
+    The projection's search takes a different number of path evaluations in each run (one per step
+    near the path; up to a few dozen where the distance is flat in s, :mod:`auvtrack.reference.path`).
+    Its rewritten lane form (:mod:`auvtrack.engine.lanes`) would run every loop for as long as its
+    slowest lane, with the mask bookkeeping of every lane at each pass; called once per lane, each run
+    takes only its own steps.  Each lane's values are the scalar function's, bit for bit (it is that
+    function, on that lane's column of ``acc`` and ``path``).
+
+    Parameters
+    ----------
+    acc : array of Lanes
+        The accumulators (one per lane), modified in place.
+    t, dt, t0, t1, t_late : float or Lanes
+        As :func:`path_update`, per lane or shared.
+    p : tuple of 3 float or Lanes
+        The navigation point of each lane.
+    path : array of Lanes
+        Each lane's packed reference.
+    m : Lanes of bool
+        The lanes to update.
+    """
+    for k in range(lane_count(m)):
+        if lane_at(m, k):
+            path_update(lane_column(acc, k), lane_at(t, k), lane_at(dt, k),
+                        (lane_at(p[0], k), lane_at(p[1], k), lane_at(p[2], k)), lane_column(path, k),
+                        lane_at(t0, k), lane_at(t1, k), lane_at(t_late, k))
+
+
+path_update.lane_form = path_update_lanes
 
 @njit_noalloc(inline="always")
 def effort_update(acc, t, dt, f, t0, t1):
