@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from .jit import njit, njit_noalloc
+from .jit.lane_values import lane_at, lane_column, lane_count
 from .reference.path import SPEED2_MIN, along_track_error, path_errors, project, project_from
 
 AXES = ("x", "y", "z")
@@ -200,11 +201,15 @@ def _path_add(acc, off, dt, y_e, z_e, along):
 def path_update(acc, t, dt, p, path, t0, t1, t_late):
     """Project the navigation point on the path and add the step to the path-following sums.
 
-    The projection (:func:`auvtrack.reference.path.project`) runs at every step, inside the window
-    or not, from the previous step's path parameter (the time ``t`` at the first step), within
-    :data:`PATH_WINDOW` of it, starting from the path point the previous step found there (kept in
-    the accumulator: the same numbers as evaluating it again, one evaluation fewer); the cross-track, vertical-track and along-track errors are then
-    accumulated over the window ``[t0, t1)`` and over its second half ``t >= t_late``.
+    The projection (:func:`auvtrack.reference.path.project`) runs at every step up to the end of
+    the window, before it too, from the previous step's path parameter (the time ``t`` at the first
+    step), within :data:`PATH_WINDOW` of it, starting from the path point the previous step found
+    there (kept in the accumulator: the same numbers as evaluating it again, one evaluation fewer);
+    the cross-track, vertical-track and along-track errors are then accumulated over the window
+    ``[t0, t1)`` and over its second half ``t >= t_late``.  Each projection is warm-started from the
+    previous one, so the steps before ``t0`` are projected for the answers inside the window to be
+    those of the chain from the first step; a step at or after ``t1`` is not projected at all: its
+    answer would only warm-start later steps, which are outside the window too.
 
     Parameters
     ----------
@@ -221,6 +226,9 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
     t_late : float
         Start of the window's second half (s).
     """
+    tol = TOL_FRACTION * dt
+    if t >= t1 - tol:  # after the window (the rule of metrics_update): nothing to add or to warm-start
+        return
     guess = acc[OFF_PATH_S]
     if math.isnan(guess):
         s, pt = project(path, t, p, PATH_WINDOW)
@@ -232,8 +240,7 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
     for i in range(3):
         for j in range(3):
             acc[OFF_PATH_PT + 3 * i + j] = pt[i][j]
-    tol = TOL_FRACTION * dt
-    if t < t0 - tol or t >= t1 - tol:
+    if t < t0 - tol:
         return
     e = path_errors(pt, p)
     along = along_track_error(pt, s, t)
@@ -241,6 +248,39 @@ def path_update(acc, t, dt, p, path, t0, t1, t_late):
     if t >= t_late - tol:
         _path_add(acc, OFF_PATH_LATE, dt, e[1], e[2], along)
 
+
+@njit_noalloc(inline="always")
+def path_update_lanes(acc, t, dt, p, path, t0, t1, t_late, m):
+    """Lane form of :func:`path_update` (SIMD batch): the scalar function once per lane of the mask ``m``.
+
+    The projection's search takes a different number of path evaluations in each run (one per step
+    near the path; up to a few dozen where the distance is flat in s, :mod:`auvtrack.reference.path`).
+    Its rewritten lane form (:mod:`auvtrack.engine.lanes`) would run every loop for as long as its
+    slowest lane, with the mask bookkeeping of every lane at each pass; called once per lane, each run
+    takes only its own steps.  Each lane's values are the scalar function's, bit for bit (it is that
+    function, on that lane's column of ``acc`` and ``path``).
+
+    Parameters
+    ----------
+    acc : array of Lanes
+        The accumulators (one per lane), modified in place.
+    t, dt, t0, t1, t_late : float or Lanes
+        As :func:`path_update`, per lane or shared.
+    p : tuple of 3 float or Lanes
+        The navigation point of each lane.
+    path : array of Lanes
+        Each lane's packed reference.
+    m : Lanes of bool
+        The lanes to update.
+    """
+    for k in range(lane_count(m)):
+        if lane_at(m, k):
+            path_update(lane_column(acc, k), lane_at(t, k), lane_at(dt, k),
+                        (lane_at(p[0], k), lane_at(p[1], k), lane_at(p[2], k)), lane_column(path, k),
+                        lane_at(t0, k), lane_at(t1, k), lane_at(t_late, k))
+
+
+path_update.lane_form = path_update_lanes
 
 @njit_noalloc(inline="always")
 def effort_update(acc, t, dt, f, t0, t1):

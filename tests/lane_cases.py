@@ -73,6 +73,15 @@ def stores(a, x):
     return a[0] + a[a.shape[0] - 1]
 
 
+
+@njit_noalloc
+def gathers(a, b, i, j):
+    """Loads and stores at each lane's own index (1-D and 2-D, an index of lanes next to a plain one)."""
+    x = a[i] + b[i, j] * 0.5 - b[j, 1]
+    a[j] = x - a[i]
+    b[i, 2] += x
+    return x + a[j] * b[i, 2]
+
 @njit
 def maths(x, p):
     """Scalar maths per lane: exp, pow, tanh, min, max, int, floor, isfinite, division."""

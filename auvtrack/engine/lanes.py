@@ -622,6 +622,11 @@ def lane_version(disp):
         if got is not None:
             return got
         fn = disp.py_func
+        custom = getattr(disp, "lane_form", None)
+        if custom is not None:  # a hand-written lane form (e.g. the scalar function once per lane of the mask)
+            _CACHE[disp] = custom
+            _SOURCES[disp] = f"(hand-written: {custom.py_func.__module__}.{custom.py_func.__qualname__})\n"
+            return custom
         if getattr(disp, "lane_stub", False):  # a function the lane kernels never run (the logger)
             out = _stub(disp)
             _CACHE[disp] = out

@@ -32,7 +32,8 @@ from numba.np.arrayobj import make_array, populate_array
 
 __all__ = ["Lanes", "lanes_of", "as_lanes", "sel", "any_lane", "all_lanes", "no_lanes", "mask_and", "mask_or",
            "mask_not", "mask_andnot", "truth", "lanes_like", "lane_min", "lane_max", "in_range", "get_lane",
-           "set_lane", "full_mask", "first_lanes", "never", "lane_zeros", "lane_copy"]
+           "set_lane", "full_mask", "first_lanes", "never", "lane_zeros", "lane_copy", "lane_column", "lane_at",
+           "lane_count"]
 
 
 class Lanes(types.Type):
@@ -464,23 +465,79 @@ def _gather(context, builder, sig, args):
 
 
 def _lane_positions(context, builder, aryty, ary, idxs, tys):
-    """Element offsets (in scalars, lane 0 of the element) of each lane's index, and whether all are equal."""
+    """Element offsets (in scalars, lane 0 of the element) of each lane's index, and whether all are equal.
+
+    The offsets are computed as one integer vector (the row-major flat index of each lane times the
+    lane count) and compared with lane 0's in one vector comparison; the per-lane offsets are its
+    elements.  Only the address arithmetic is vectorised: every lane loads (or stores) the element
+    it indexed before, so the values are unchanged.
+    """
     lanes = aryty.dtype
     base = builder.bitcast(ary.data, context.get_value_type(lanes.dtype).as_pointer())
     shape = cgutils.unpack_tuple(builder, ary.shape)
-    L = context.get_constant(types.intp, lanes.count)
-    pos = []
-    for k in range(lanes.count):
-        flat = context.get_constant(types.intp, 0)
-        for i, (v, t) in enumerate(zip(idxs, tys)):
-            x = _lane(builder, v, k) if isinstance(t, Lanes) else context.cast(builder, v, t, types.intp)
-            flat = builder.add(builder.mul(flat, shape[i]), x) if i else x
-        pos.append(builder.mul(flat, L))
-    same = ir.Constant(ir.IntType(1), 1)
-    for k in range(1, lanes.count):
-        same = builder.and_(same, builder.icmp_signed("==", pos[k], pos[0]))
+    intp = context.get_value_type(types.intp)
+    vty = ir.VectorType(intp, lanes.count)
+
+    def vec(v, t):
+        if isinstance(t, Lanes):
+            return v if v.type == vty else builder.sext(v, vty)
+        return _broadcast(builder, context.cast(builder, v, t, types.intp), vty, lanes.count)
+
+    flat = None
+    for i, (v, t) in enumerate(zip(idxs, tys)):
+        x = vec(v, t)
+        flat = x if flat is None else builder.add(builder.mul(flat, _broadcast(builder, shape[i], vty, lanes.count)), x)
+    pos_v = builder.mul(flat, ir.Constant(vty, [lanes.count] * lanes.count))
+    first = builder.shuffle_vector(pos_v, pos_v, ir.Constant(ir.VectorType(ir.IntType(32), lanes.count),
+                                                             [0] * lanes.count))
+    same = _vcall(builder, "llvm.vector.reduce.and", [builder.icmp_signed("==", pos_v, first)], ir.IntType(1))
+    pos = [builder.extract_element(pos_v, _i32(k)) for k in range(lanes.count)]
     return base, pos, same
 
+
+@intrinsic
+def lane_column(typingctx, a, k):
+    """Lane ``k`` of a 1-D array of :class:`Lanes`: a float64 (or int64) array view of that lane's
+    elements, strided over the others (loads and stores go to the array of lanes itself)."""
+    if not (isinstance(a, types.Array) and isinstance(a.dtype, Lanes) and a.ndim == 1
+            and isinstance(k, types.Integer)):
+        return None
+    ret = types.Array(a.dtype.dtype, 1, "A")
+
+    def codegen(context, builder, sig, args):
+        ary = make_array(a)(context, builder, args[0])
+        out = make_array(ret)(context, builder)
+        base = builder.bitcast(ary.data, context.get_data_type(ret.dtype).as_pointer())
+        data = builder.gep(base, [context.cast(builder, args[1], sig.args[1], types.intp)])
+        itemsize = context.get_constant(types.intp, context.get_abi_sizeof(context.get_data_type(ret.dtype)))
+        populate_array(out, data=data, shape=ary.shape, strides=ary.strides, itemsize=itemsize,
+                       meminfo=ary.meminfo, parent=ary.parent)
+        return impl_ret_borrowed(context, builder, ret, out._getvalue())
+
+    return ret(a, k), codegen
+
+
+@intrinsic
+def lane_at(typingctx, x, k):
+    """Lane ``k`` of a lane value as a scalar; a scalar (the same in every lane) as it is."""
+    if not isinstance(k, types.Integer):
+        return None
+    if isinstance(x, Lanes):
+        def codegen(context, builder, sig, args):
+            return builder.extract_element(args[0], context.cast(builder, args[1], sig.args[1], types.int32))
+
+        return x.dtype(x, k), codegen
+    if _scalar_dtype(x) is None:
+        return None
+    return types.unliteral(x)(x, k), lambda context, builder, sig, args: args[0]
+
+
+@intrinsic
+def lane_count(typingctx, m):
+    """The number of lanes of a lane value (a compile-time constant)."""
+    if not isinstance(m, Lanes):
+        return None
+    return types.intp(m), lambda context, builder, sig, args: context.get_constant(types.intp, m.count)
 
 # ------------------------------------------------------------------ masks and selects
 

@@ -132,6 +132,36 @@ def test_masked_stores_keep_the_other_lanes():
     np.testing.assert_array_equal(a, want_a)
 
 
+
+@settings(max_examples=40)
+@given(data=st.data())
+def test_loads_and_stores_at_each_lanes_own_index(data):
+    """Indexing an array of lanes with an index of lanes: each lane reads and writes its own element,
+    whether the lanes' indexes are all alike (one vector load or store) or not (one per lane), in 1-D
+    and in 2-D next to a plain index."""
+    if "gathers" not in _DRIVERS:
+        lane = lane_version(lane_cases.gathers)
+
+        @numba.njit
+        def drive(a, b, i, j, out):
+            r = lane(as_lanes(a, L), as_lanes(b, L), as_lanes(i, L)[0], as_lanes(j, L)[0], full_mask(L))
+            for k in range(L):
+                out[k] = get_lane(r, k)
+
+        _DRIVERS["gathers"] = drive
+    drive = _DRIVERS["gathers"]
+    rng = np.random.default_rng(data.draw(st.integers(0, 2**32 - 1)))
+    a, b = rng.normal(size=(5, L)), rng.normal(size=(5, 3, L))
+    alike = data.draw(st.booleans())
+    i = np.full((1, L), data.draw(st.integers(0, 4))) if alike else rng.integers(0, 5, size=(1, L))
+    j = rng.integers(0, 3, size=(1, L))
+    want_a, want_b = a.copy(), b.copy()
+    want = np.array([lane_cases.gathers.py_func(want_a[:, k], want_b[:, :, k], i[0, k], j[0, k]) for k in range(L)])
+    out = np.zeros(L)
+    drive(a, b, i, j, out)
+    assert out.tobytes() == want.tobytes()
+    assert a.tobytes() == want_a.tobytes() and b.tobytes() == want_b.tobytes()
+
 def test_unsupported_constructs_are_refused_by_name(tmp_path):
     f = tmp_path / "odd_law.py"
     f.write_text("from auvtrack.jit import njit\n\n@njit\ndef odd(x):\n    for v in (1.0, 2.0):\n"
@@ -262,6 +292,18 @@ def test_simd_batch_equals_single_runs_with_failures_at_different_times(kind):
         assert len(times) >= 2, "the batch should have lanes failing at different times"
         assert {r.status for r in singles} == {"ok", "failed"}
 
+
+
+def test_simd_batch_with_metric_windows_ending_at_different_times_equals_single_runs():
+    """The path-following metrics of lanes whose metric windows start and end at different steps (a lane
+    stops projecting at the end of its window while the others go on), bit for bit those of single runs."""
+    cases = [{"controller.kind": "fxtntsmc", "seed": i, "sim.duration": 0.6,
+              "metrics.window": [0.02 * i, 0.15 + 0.04 * i]} for i in range(L)]
+    preps = [prepare(load_scenario(PAPER, c)) for c in cases]
+    singles = [run_prepared(p) for p in preps]
+    for s, r in zip(run_batch(preps, backend="simd", workers=2), singles):
+        _same_run(s, r, bitwise=True)
+        assert math.isfinite(r.metrics["xtrack_rmse"]) and math.isfinite(r.metrics["along_rmse_late"])
 
 def test_simd_batch_on_the_6dof_plants_equals_single_runs():
     """Both 6-DOF preset modules (Prestero, Fossen) in lanes: a tracking law with noise, sampled-data
