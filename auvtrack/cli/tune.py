@@ -27,7 +27,8 @@ from .signals import stop_once
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help=f"Add the trials on an existing Dask scheduler, tcp://host:port (probed for {SCHEDULER_TIMEOUT_S:g} s "
                    "first); its workers must reach --out.")
-@click.option("--backend", default=None, metavar="NAME", help="Back end of the batch runner.")
+@click.option("--backend", default=None, metavar="NAME", help="Back end of the batch runner (default: simd lanes where the vector math library is in use, "
+                   "else threads; the same results).")
 @click.option("--no-validate", is_flag=True, help="Do not fly the best gains on the validation split.")
 @click.option("--quiet", is_flag=True, help="No progress line, no compile notice or bar, no Optuna log or warnings.")
 def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, seed: int, workers: int,

@@ -15,7 +15,10 @@ the scenario's reference by default (:func:`reference_speed`), ``vehicle.u0`` ov
 """
 from __future__ import annotations
 
+import functools
 import math
+from types import MappingProxyType
+from typing import Mapping
 
 import numpy as np
 
@@ -23,6 +26,12 @@ from .truth_presets import load_preset6
 
 SOURCE_6DOF = "remus100_prestero"
 U0_MIN, U0_MAX = 0.05, 3.0  # m/s: the range a linearisation speed may take
+
+
+@functools.lru_cache(maxsize=None)
+def _values6(name: str) -> Mapping[str, float | tuple]:
+    """The checked numbers of a 6-DOF preset, read once (read-only: every run of a batch reduces them)."""
+    return MappingProxyType(dict(load_preset6(name).values))
 
 
 def reduce_prestero(u0: float) -> dict:
@@ -45,7 +54,7 @@ def reduce_prestero(u0: float) -> dict:
     """
     if not (isinstance(u0, (int, float)) and U0_MIN <= u0 <= U0_MAX):
         raise ValueError(f"vehicle.u0: must be a speed in [{U0_MIN}, {U0_MAX}] m/s (got {u0!r})")
-    v = load_preset6(SOURCE_6DOF).values
+    v = _values6(SOURCE_6DOF)
     m = v["mass.W"] / v["mass.g"]
     mm = (m - v["added_mass.X_udot"], m - v["added_mass.Y_vdot"], m - v["added_mass.Z_wdot"],
           v["mass.Iyy"] - v["added_mass.M_qdot"], v["mass.Izz"] - v["added_mass.N_rdot"])
