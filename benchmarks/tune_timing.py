@@ -125,7 +125,8 @@ def main() -> None:
     ap.add_argument("--budget", type=int, default=10, help="trials of each timed tuning")
     ap.add_argument("--repeat", type=int, default=1, help="timed tunings (medians reported)")
     ap.add_argument("--out", default=None, help="folder of the studies (default: a temporary one)")
-    ap.add_argument("--workers", type=int, default=1, help="threads of the batch runner in a trial")
+    ap.add_argument("--workers", type=int, default=None,
+                    help="threads of the batch runner in a trial (default: tune's, every core)")
     ap.add_argument("--backend", default=None, help="back end of the batch runner (default: tune's, "
                     "auvtrack.batch.runner.preferred_backend)")
     ap.add_argument("--parallel", type=int, default=1, help="trials flown at once (tune --parallel)")
@@ -165,13 +166,14 @@ def main() -> None:
     if a.parallel == 1:
         med["phase_s"] = {p: statistics.median(r["phase_s"][p] for r in reps) for p in reps[0]["phase_s"]}
     from auvtrack import __version__
+    from auvtrack.batch.runner import default_workers
 
     record = {"measured": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="minutes"),
               "machine": f"{platform.machine()} / {platform.processor() or platform.node()} / Python "
                          f"{platform.python_version()}",
               "cpu_count": os.cpu_count(), "version": __version__, "controller": a.controller, "suite": st.name,
               "split": "training", "runs_per_trial": len(probe), "budget": a.budget, "repeat": a.repeat,
-              "workers": a.workers, "backend": backend, "parallel": a.parallel, "chunk": a.chunk,
+              "workers": a.workers if a.workers else (default_workers() if a.parallel == 1 else 1), "backend": backend, "parallel": a.parallel, "chunk": a.chunk,
               "warm_s": round(warm, 2), "note": a.note, "repeats": reps, "median": med}
     trials_s = med["trials_per_s"]
     record["estimate_budget_200_s"] = round(200 / trials_s, 1) if trials_s else None
