@@ -117,6 +117,30 @@ def _one(a: argparse.Namespace, out: Path, profile: str | None) -> dict[str, Any
     return rec
 
 
+def summary(record: dict[str, Any]) -> str:
+    """The sentence docs/tuning.md quotes from a record (a test checks the doc holds it).
+
+    Parameters
+    ----------
+    record : dict
+        A record of this script (``benchmarks/tune_timing.json``).
+
+    Returns
+    -------
+    str
+        Trials/s, runs/s, the shares and the load, with the budget, back end and workers.
+    """
+    med, reps = record["median"], record["repeats"]
+    loads = [x for r in reps for x in (r["load_before"][0], r["load_after"][0])]
+    cpu = statistics.median(r["cpu_s"] / r["runs"] for r in reps if r["runs"])
+    return (f"{record['controller']} on {record['suite']}'s training split ({record['runs_per_trial']} runs a "
+            f"trial), {record['budget']} trials x {record['repeat']}, back end {record['backend']}, "
+            f"{record['workers']} workers: {med['trials_per_s']:g} trials/s, {med['runs_per_s']:g} runs/s, "
+            f"{100 * med['kernel_share']:.0f} % of the trials' wall time in the batch runner's kernels and "
+            f"{100 * med['outside_share']:.0f} % outside them, {1000 * cpu:.0f} ms of CPU a run, at a load average of {min(loads):.1f}-"
+            f"{max(loads):.1f} on {record['cpu_count']} cores ({record['measured']})")
+
+
 def main() -> None:
     """Time the tunings and print (and write) the record."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -161,7 +185,7 @@ def main() -> None:
         reps.append(_one(a, root / f"rep{k}", a.profile if k == 0 else None))
         print(json.dumps(reps[-1]), flush=True)
     med = {key: statistics.median(r[key] for r in reps)
-           for key in ("wall_s", "trials_per_s", "runs_per_s", "steps_per_s", "kernel_share", "outside_share")
+           for key in ("wall_s", "cpu_s", "trials_per_s", "runs_per_s", "steps_per_s", "kernel_share", "outside_share")
            if all(key in r for r in reps)}
     if a.parallel == 1:
         med["phase_s"] = {p: statistics.median(r["phase_s"][p] for r in reps) for p in reps[0]["phase_s"]}
@@ -179,6 +203,7 @@ def main() -> None:
     record["estimate_budget_200_s"] = round(200 / trials_s, 1) if trials_s else None
     text = json.dumps(record, indent=1)
     print(text)
+    print(summary(record))
     if a.json:
         Path(a.json).write_text(text + "\n")
 
