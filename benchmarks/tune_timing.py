@@ -184,11 +184,11 @@ def main() -> None:
     for k in range(a.repeat):
         reps.append(_one(a, root / f"rep{k}", a.profile if k == 0 else None))
         print(json.dumps(reps[-1]), flush=True)
-    med = {key: statistics.median(r[key] for r in reps)
+    med = {key: round(statistics.median(r[key] for r in reps), 4)
            for key in ("wall_s", "cpu_s", "trials_per_s", "runs_per_s", "steps_per_s", "kernel_share", "outside_share")
            if all(key in r for r in reps)}
     if a.parallel == 1:
-        med["phase_s"] = {p: statistics.median(r["phase_s"][p] for r in reps) for p in reps[0]["phase_s"]}
+        med["phase_s"] = {p: round(statistics.median(r["phase_s"][p] for r in reps), 2) for p in reps[0]["phase_s"]}
     from auvtrack import __version__
     from auvtrack.batch.runner import default_workers
 
