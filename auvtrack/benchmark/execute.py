@@ -175,8 +175,10 @@ def _schema():
     return pa.schema(fields + [pa.field(m, pa.float64()) for m in METRIC_NAMES])
 
 
-def _prepare(spec: RunSpec):
+def _prepare(spec: RunSpec, plant_cache: dict | None = None):
     """A Prepared run, or the one-line reason the controller's set-up refused it.
+
+    ``plant_cache``: :func:`auvtrack.simulation.pipeline.prepare`'s (runs sharing their conditions).
 
     A plug-in's set-up is user code: any exception it raises is its refusal of the run (with the
     exception's type), never a traceback in the middle of a comparison.
@@ -191,7 +193,7 @@ def _prepare(spec: RunSpec):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return prepare(load_scenario(spec.raw, spec.overrides))
+            return prepare(load_scenario(spec.raw, spec.overrides), plant_cache=plant_cache)
     except refusals as exc:
         if isinstance(exc, PluginFailure):
             return exc.cause
@@ -276,7 +278,8 @@ def _table(rows: list[dict[str, Any]]):
     return pa.Table.from_pydict({f.name: [r[f.name] for r in rows] for f in schema}, schema=schema)
 
 
-def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1, backend: str | None = None):
+def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1, backend: str | None = None,
+              plant_cache: dict | None = None):
     """Prepare and run ``specs`` (metrics only) and return one row per run as an Arrow table.
 
     A run whose set-up is refused (a controller rejecting its gains or the start) is a failure
@@ -292,6 +295,9 @@ def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1, backend: str
     backend : str, optional
         A back end of :func:`auvtrack.batch.runner.run_batch` (one of its ``BACKENDS``); default:
         the batch runner's default.
+    plant_cache : dict, optional
+        Plant set-ups to reuse and fill (:func:`auvtrack.simulation.pipeline.prepare`): a
+        tuning's candidates fly the same runs with other gains.
 
     Returns
     -------
@@ -302,7 +308,7 @@ def run_chunk(specs: Sequence[RunSpec], *, workers: int | None = 1, backend: str
     from ..batch.runner import run_batch
     from ..report import failure_cause
 
-    prepared = [_prepare(s) for s in specs]
+    prepared = [_prepare(s, plant_cache) for s in specs]
     runnable = [p for p in prepared if not isinstance(p, str)]
     summaries = iter(run_batch(runnable, workers=workers, **_backend_kw(backend)))
     rows = []

@@ -19,18 +19,20 @@ from .signals import stop_once
               help="Output folder: study.db (resumed when present), the preset, results.json, report.html.")
 @click.option("--sampler", type=click.Choice(["tpe", "cmaes"]), default="tpe", show_default=True)
 @click.option("--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True, help="Sampler seed.")
-@click.option("--workers", type=click.IntRange(1, 256), default=1, show_default=True,
-              help="Threads of the batch runner inside a trial.")
+@click.option("--workers", type=click.IntRange(1, 256), default=None,
+              help="Threads of the batch runner inside a trial [default: every core; 1 with --parallel > 1 or "
+                   "--scheduler, whose trials run side by side].")
 @click.option("--parallel", type=click.IntRange(1, 256), default=1, show_default=True,
               help="Trials flown at once by local processes adding to the one study (with --scheduler: Dask tasks, "
                    "default one per thread of the cluster).")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help=f"Add the trials on an existing Dask scheduler, tcp://host:port (probed for {SCHEDULER_TIMEOUT_S:g} s "
                    "first); its workers must reach --out.")
-@click.option("--backend", default=None, metavar="NAME", help="Back end of the batch runner.")
+@click.option("--backend", default=None, metavar="NAME", help="Back end of the batch runner (default: simd lanes where the vector math library is in use, "
+                   "else threads; the same results).")
 @click.option("--no-validate", is_flag=True, help="Do not fly the best gains on the validation split.")
 @click.option("--quiet", is_flag=True, help="No progress line, no compile notice or bar, no Optuna log or warnings.")
-def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, seed: int, workers: int,
+def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, seed: int, workers: int | None,
          parallel: int, scheduler: str | None, backend: str | None, no_validate: bool, quiet: bool) -> None:
     """Tune a controller for the suite's vehicle with Optuna; Ctrl-C or SIGTERM keeps the study, run again to resume.
 
@@ -41,6 +43,8 @@ def tune(controller: str, suite_name: str, budget: int, out: str, sampler: str, 
     from ..tuning import tune as _tune
 
     stopped = None
+    if workers is None and (parallel > 1 or scheduler):
+        workers = 1  # one thread per trial flown at once
 
     def progress(done: int, total: int) -> None:
         if not quiet:

@@ -126,13 +126,50 @@ def _c(a) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
-def prepare(scenario: Scenario) -> Prepared:
+def _plant_key(sc: Scenario, pctx: PlantContext, name: str) -> str:
+    """Everything a plant's ``setup`` reads, as text: equal keys, equal set-ups (floats by their exact repr)."""
+    import json
+
+    def plain(o: Any) -> Any:
+        if isinstance(o, np.ndarray):
+            return [str(o.dtype), list(o.shape), o.tobytes().hex()]
+        if hasattr(o, "model_dump"):
+            return o.model_dump(mode="json")
+        raise TypeError(type(o).__name__)
+
+    doc = [name, sc.plant, pctx.eta0, pctx.nu0, pctx.phi0, pctx.p0, pctx.vp_true, pctx.vehicle_record,
+           pctx.design_preset, pctx.actuator, pctx.commands, pctx.seed]
+    return json.dumps(doc, default=plain, sort_keys=True)
+
+
+def _plant_setup(plant_spec, sc: Scenario, pctx: PlantContext, cache: dict | None):
+    """``plant_spec.setup`` of the run, from ``cache`` when a built-in plant was set up on the same inputs."""
+    from dataclasses import replace
+
+    if cache is None or not plant_spec.module.startswith("auvtrack."):
+        return plant_spec.setup(sc.plant, pctx)  # a plug-in plant's set-up is the user's: never reused
+    try:
+        key = _plant_key(sc, pctx, plant_spec.name)
+    except TypeError:  # an input without a text form: set up again
+        return plant_spec.setup(sc.plant, pctx)
+    cpl = cache.get(key)
+    if cpl is None:
+        cpl = cache[key] = plant_spec.setup(sc.plant, pctx)
+    return replace(cpl, pp=np.array(cpl.pp, dtype=np.float64), x0=np.array(cpl.x0, dtype=np.float64))
+
+
+def prepare(scenario: Scenario, *, plant_cache: dict | None = None) -> Prepared:
     """Build every array the compiled engine needs from a validated scenario.
 
     Parameters
     ----------
     scenario : Scenario
         A validated scenario (:func:`auvtrack.load_scenario`).
+    plant_cache : dict, optional
+        Set-ups of built-in plants already made, by their inputs (the plant section, the initial
+        state, the vehicles, the actuator, what the controller commands, the seed): runs that
+        differ in their controller's gains only (a tuning's candidates) set their plant up once.
+        The run gets its own copies of the cached arrays; the dict is filled as runs are prepared.
 
     Returns
     -------
@@ -155,7 +192,7 @@ def prepare(scenario: Scenario) -> Prepared:
     pctx = PlantContext(eta0=eta0, nu0=nu0, phi0=float(sc.initial.phi), p0=float(sc.initial.p), vp_true=vp_true,
                         vehicle_record=record, design_preset=sc.vehicle.preset, actuator=sc.actuator,
                         commands=cspec.command_on(plant_spec), seed=sc.seed)
-    cpl = plant_spec.setup(sc.plant, pctx)
+    cpl = _plant_setup(plant_spec, sc, pctx, plant_cache)
     plant_module = cpl.module or plant_spec.module
     ref = build_reference(dict(sc.reference))
     ref_p = ref.pack()

@@ -12,7 +12,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
-__all__ = ["TUNING_SPLITS", "split_specs", "score_table", "Evaluation", "evaluate", "candidate_table"]
+__all__ = ["TUNING_SPLITS", "split_conditions", "split_specs", "score_table", "Evaluation", "evaluate",
+           "candidate_table"]
 
 TUNING_SPLITS = ("training", "validation")
 """The splits a tuning may fly; never the evaluation seeds."""
@@ -42,7 +43,44 @@ def candidate_table(base: Mapping[str, Any], gains: Mapping[str, float]) -> dict
     return table
 
 
-def split_specs(suite, table: Mapping[str, Any], split: str, label: str = "candidate") -> list:
+def split_conditions(suite, split: str) -> list[tuple[str, str, int, tuple[dict, dict, dict]]]:
+    """What every run of ``split`` imposes whatever the controller (:meth:`Suite.conditions`), in run order.
+
+    A tuning computes them once and builds each candidate's runs on them (:func:`split_specs`):
+    only the ``[controller]`` table differs between candidates.
+
+    Parameters
+    ----------
+    suite : auvtrack.benchmark.suite.Suite
+        The suite.
+    split : str
+        ``"training"`` or ``"validation"``.
+
+    Returns
+    -------
+    list of (str, str, int, tuple)
+        Task, tier, seed index and the conditions; cell-major (task, tier), then seed index.
+
+    Raises
+    ------
+    ValueError
+        ``split`` is the evaluation split or unknown, or a seed index of it is an evaluation seed.
+    """
+    if split not in TUNING_SPLITS:
+        raise ValueError(f"split: must be one of {', '.join(TUNING_SPLITS)} (got {split!r}): a tuning never "
+                         "flies the evaluation seeds")
+    seeds = suite.split_seeds(split)
+    out = []
+    for task, tier in suite.split_cells(split):
+        for i in seeds:
+            if suite.split_of(i) != split:
+                raise ValueError(f"splits.{split}: seed index {i} belongs to the {suite.split_of(i)} split")
+            out.append((task, tier, i, suite.conditions(task, tier, i)))
+    return out
+
+
+def split_specs(suite, table: Mapping[str, Any], split: str, label: str = "candidate", *,
+                conditions: Sequence[tuple[str, str, int, tuple[dict, dict, dict]]] | None = None) -> list:
     """The runs of ``split`` for one controller table, as the comparison's ``RunSpec`` records.
 
     Parameters
@@ -55,6 +93,8 @@ def split_specs(suite, table: Mapping[str, Any], split: str, label: str = "candi
         ``"training"`` or ``"validation"``.
     label : str, optional
         The controller label in the rows.
+    conditions : sequence, optional
+        ``split_conditions(suite, split)`` when already computed (a tuning's trials share them).
 
     Returns
     -------
@@ -69,19 +109,16 @@ def split_specs(suite, table: Mapping[str, Any], split: str, label: str = "candi
     from ..benchmark.execute import RunSpec
     from ..benchmark.suite import ControllerEntry
 
-    if split not in TUNING_SPLITS:
+    if conditions is None:
+        conditions = split_conditions(suite, split)
+    elif split not in TUNING_SPLITS:
         raise ValueError(f"split: must be one of {', '.join(TUNING_SPLITS)} (got {split!r}): a tuning never "
                          "flies the evaluation seeds")
-    seeds = suite.split_seeds(split)
     entry = ControllerEntry(label, dict(table), "tuning candidate")
-    specs, r = [], 0
-    for task, tier in suite.split_cells(split):
-        for i in seeds:
-            if suite.split_of(i) != split:
-                raise ValueError(f"splits.{split}: seed index {i} belongs to the {suite.split_of(i)} split")
-            raw, ov, drawn = suite.scenario(entry, task, tier, i)
-            specs.append(RunSpec(r, label, task, tier, i, raw, ov, drawn))
-            r += 1
+    specs = []
+    for r, (task, tier, i, cond) in enumerate(conditions):
+        raw, ov, drawn = suite.scenario(entry, task, tier, i, cond)
+        specs.append(RunSpec(r, label, task, tier, i, raw, ov, drawn))
     return specs
 
 
@@ -140,7 +177,8 @@ class Evaluation:
 
 
 def evaluate(suite, specs: Sequence, *, chunk: int | None = None, stop_on_failure: bool = False,
-             workers: int | None = 1, backend: str | None = None, on_chunk=None) -> Evaluation:
+             workers: int | None = 1, backend: str | None = None, on_chunk=None,
+             plant_cache: dict | None = None) -> Evaluation:
     """Fly ``specs`` with the comparison's executor and score them with the benchmark's score.
 
     Parameters
@@ -159,6 +197,8 @@ def evaluate(suite, specs: Sequence, *, chunk: int | None = None, stop_on_failur
         Back end of the batch runner.
     on_chunk : callable, optional
         ``on_chunk(evaluation)`` after each batch (progress, Optuna's intermediate values).
+    plant_cache : dict, optional
+        Plant set-ups shared by the candidates of a tuning (:func:`auvtrack.benchmark.execute.run_chunk`).
 
     Returns
     -------
@@ -170,7 +210,7 @@ def evaluate(suite, specs: Sequence, *, chunk: int | None = None, stop_on_failur
     ev = Evaluation()
     size = chunk or max(len(specs), 1)
     for start in range(0, len(specs), size):
-        table = run_chunk(specs[start:start + size], workers=workers, backend=backend)
+        table = run_chunk(specs[start:start + size], workers=workers, backend=backend, plant_cache=plant_cache)
         ev.scores += score_table(suite, table)
         rows = table.to_pylist()
         ev.rows += rows

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator, Mapping
 
-from .objective import candidate_table, evaluate, split_specs
+from .objective import candidate_table, evaluate, split_conditions, split_specs
 from .space import Dimension, constraint_violations, distributions, field_values, search_space, searched_fields
 
 __all__ = ["SAMPLERS", "STUDY_NAME", "TrialJob", "TuneResult", "add_trials", "controller_base", "designed_base",
@@ -463,15 +463,21 @@ def _running(study) -> list:
     return study.get_trials(deepcopy=False, states=(TrialState.RUNNING,))
 
 
-def _fly(study, trial, job: TrialJob, st, cost: dict, space: Mapping[str, Dimension]) -> None:
-    """Fly one asked trial on the split (or refuse it on a set-up condition) and tell the study."""
+def _fly(study, trial, job: TrialJob, st, cost: dict, space: Mapping[str, Dimension], conditions: list,
+         plants: dict) -> None:
+    """Fly one asked trial on the split (or refuse it on a set-up condition) and tell the study.
+
+    ``conditions`` are the split's (:func:`~auvtrack.tuning.objective.split_conditions`) and
+    ``plants`` its plant set-ups (:func:`auvtrack.simulation.pipeline.prepare`), made once per
+    worker: only the controller differs between trials.
+    """
     import optuna
 
     from ..scenario import load_scenario
 
     w0, c0 = time.perf_counter(), time.process_time()
     table = candidate_table(job.base, field_values(space, trial.params))
-    specs = split_specs(st, table, job.split)
+    specs = split_specs(st, table, job.split, conditions=conditions)
     problems = constraint_violations(load_scenario(specs[0].raw, specs[0].overrides))
     if problems:
         # scored as the benchmark scores a refused set-up: every run failed at t = 0
@@ -492,7 +498,7 @@ def _fly(study, trial, job: TrialJob, st, cost: dict, space: Mapping[str, Dimens
 
         per_cell = max(len(st.split_seeds(job.split)), 1)
         ev = evaluate(st, specs, chunk=job.chunk or per_cell, stop_on_failure=True, workers=job.workers,
-                      backend=job.backend, on_chunk=report)
+                      backend=job.backend, on_chunk=report, plant_cache=plants)
         cost["runs"] += ev.runs
         cost["steps"] += ev.steps
         trial.set_user_attr("runs", ev.runs)
@@ -510,7 +516,7 @@ def _fly(study, trial, job: TrialJob, st, cost: dict, space: Mapping[str, Dimens
             study.tell(trial, ev.score)
 
 
-def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
+def add_trials(job: TrialJob, worker: int = 0, progress=None, *, suite=None) -> dict:
     """Ask, fly and tell trials until the study holds ``job.trials`` finished ones (counting those running).
 
     Several processes or Dask tasks may call this on one study at once (each with its own
@@ -526,6 +532,10 @@ def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
         This worker's index (its sampler seeds, :func:`trial_seed`).
     progress : callable, optional
         ``progress(done, total)`` after each trial.
+    suite : auvtrack.benchmark.suite.Suite, optional
+        ``job.suite`` already loaded (by :func:`tune`, in this process).  Default: read again
+        without the feasibility check (:func:`auvtrack.benchmark.suite.load_suite`'s ``check``),
+        which :func:`tune` made before any worker started.
 
     Returns
     -------
@@ -534,20 +544,22 @@ def add_trials(job: TrialJob, worker: int = 0, progress=None) -> dict:
     """
     if job.quiet:
         with silenced():
-            return _add_trials(job, worker, progress)
-    return _add_trials(job, worker, progress)
+            return _add_trials(job, worker, progress, suite)
+    return _add_trials(job, worker, progress, suite)
 
 
-def _add_trials(job: TrialJob, worker: int, progress) -> dict:
+def _add_trials(job: TrialJob, worker: int, progress, suite) -> dict:
     from optuna.trial import TrialState
 
     from ..benchmark.suite import load_suite
 
-    st = load_suite(job.suite)
+    # the feasibility check of every cell takes tens of seconds and tune made it already
+    st = suite if suite is not None else load_suite(job.suite, check=False)
     study = load_study(job.study, job.sampler, job.seed)
     space = search_space(_params_model(job.base))
     dists = distributions(space)
     cost = {"runs": 0, "steps": 0, "cpu_s": 0.0}
+    conditions, plants = split_conditions(st, job.split), {}
     while len(finished_trials(study)) + len(_running(study)) < job.trials:
         with asking(job.study):
             study.sampler = _sampler(job.sampler, trial_seed(job.seed, worker, len(finished_trials(study))))
@@ -561,7 +573,7 @@ def _add_trials(job: TrialJob, worker: int, progress) -> dict:
                 break
         c0 = time.process_time()
         try:
-            _fly(study, trial, job, st, cost, space)
+            _fly(study, trial, job, st, cost, space, conditions, plants)
         except BaseException:  # a stop: the trial's gains are asked again when the tuning resumes
             with asking(job.study):
                 _give_back(study, trial)
@@ -644,7 +656,9 @@ def tune(controller: str, suite: str | Path = "auv-track-v1", *, trials: int, ou
     workers : int or None, optional
         Threads of the batch runner within a trial.
     backend : str, optional
-        Back end of the batch runner.
+        Back end of the batch runner (default: :func:`auvtrack.batch.runner.preferred_backend`,
+        the ``simd`` lanes where the vector math library is in use, whose runs are bit-identical
+        to the thread back end's; else threads).
     chunk : int, optional
         Runs per batch inside a trial (a failing candidate is pruned after the first batch
         holding a failure; default: one (task, tier) cell).
@@ -700,6 +714,10 @@ def _tune(controller, suite, trials, out, sampler, seed, split, validate, worker
     if not space:
         raise ValueError(f"controller: {controller} declares no tunable gain (tunable(...) on its Params fields)")
     _sampler(sampler, seed)  # refuses an unknown sampler before anything is stored
+    if backend is None:  # the lanes: same runs, same bits, several runs per core at once
+        from ..batch.runner import preferred_backend
+
+        backend = preferred_backend()
     if scheduler and client is None:
         from ..batch.scheduler import probe_scheduler
 
@@ -727,7 +745,7 @@ def _tune(controller, suite, trials, out, sampler, seed, split, validate, worker
                     backend=backend, notify=notify, bar=compile_bar)
     t_wall, t_cpu = time.perf_counter(), time.process_time()
     if parallel == 1 and scheduler is None and client is None:
-        costs = [add_trials(job, 0, progress)]
+        costs = [add_trials(job, 0, progress, suite=st)]
     else:
         costs = run_workers(job, parallel=parallel, scheduler=scheduler, client=client, progress=progress)
     res.runs = sum(c["runs"] for c in costs)
