@@ -14,7 +14,8 @@ the suite's run score):
 
 Commands::
 
-    python -m tools.pid_preset_gap run      # fly the runs, write docs/results/pid-preset-gap.json
+    python -m tools.pid_preset_gap run STUDY  # fly the runs, write docs/results/pid-preset-gap.json
+                                              # (STUDY: the shipped preset's `auvtrack tune --out` folder)
     python -m tools.pid_preset_gap render   # rewrite the generated block of docs/tuning.md
     python -m tools.pid_preset_gap check    # exit status 1 when the block differs from the stored result
 
@@ -44,37 +45,72 @@ CELL = ("helix", "truth_fossen")
 DIGITAL = "digital"
 BACKEND = "simd"
 XTRACK_TARGET = 0.5  # m, the acceptance's bound on a calm truth cell's median cross-track error
-KP_STEPS = (1.0, 1.5)
-"""Proportional gains flown with the shipped preset's other gains (besides the old preset's kp)."""
+KP_FACTORS = (0.5, 1.5)
+"""Factors on the shipped preset's kp, flown with its other gains."""
+EARLY_BUDGET = 20
+"""Trials of the first auv-track-v2 presets: the shipped study's best among its first trials is flown too."""
 COLUMNS = ("xtrack_rmse", "xtrack_rmse_late", "vtrack_rmse", "energy", "tv", "act_rate_q", "act_rate_r",
            "t_act_limit_q", "t_act_limit_r")
 GAINS = ("kp", "ki", "kd", "kaw", "saturation")
 
 
-def variants() -> dict[str, tuple[dict[str, Any], str]]:
+def first_best(trials: list[dict[str, Any]], budget: int = EARLY_BUDGET) -> dict[str, Any]:
+    """The best completed trial among the first ``budget`` trials of the shipped preset's study."""
+    done = [t for t in trials if t["number"] < budget and t["state"] == "COMPLETE"]
+    if not done:
+        raise ValueError(f"no trial of the first {budget} completed")
+    return min(done, key=lambda t: (t["value"], t["number"]))
+
+
+def variants(trials: list[dict[str, Any]]) -> dict[str, tuple[dict[str, Any], str]]:
     """Label -> (the ``[controller]`` table flown, what it is).
 
-    The shipped preset, the old one, the designed gains (the tuning's first trial) and the
-    shipped preset with one gain changed: its kp raised (to :data:`KP_STEPS` and to the old
-    preset's kp), or its ki set to the designed ki (integral action).
+    The shipped preset; the best trial of the first :data:`EARLY_BUDGET` of its own study (the
+    same search stopped at the earlier presets' budget); the old preset; the designed gains (the
+    tuning's first trial); the shipped preset with its kp scaled by :data:`KP_FACTORS`.
+
+    Parameters
+    ----------
+    trials : list of dict
+        The shipped preset's study: ``number``, ``state``, ``value``, ``params`` per trial.
     """
     from auvtrack.control.gain_presets import get_gain_preset
 
     shipped = dict(get_gain_preset(SHIPPED).gains)
     prov = get_gain_preset(SHIPPED).provenance
-    old_kp = float(get_gain_preset(OLD).gains["kp"])
-    designed_ki = float(_resolved({"kind": "pid"})["ki"])
+    early = first_best(trials)
     out: dict[str, tuple[dict[str, Any], str]] = {
         "shipped": ({"kind": "pid", "preset": SHIPPED}, f"`{SHIPPED}`, the shipped preset ({prov['sampler'].upper()}, "
                     f"{prov['budget_trials']} trials)"),
+        "early": ({"kind": "pid", **shipped, **early["params"]},
+                  f"the best of the same study's first {EARLY_BUDGET} trials (trial {early['number']})"),
         "old": ({"kind": "pid", "preset": OLD}, f"`{OLD}`, differential evolution on the paper's vehicle (docs below)"),
         "designed": ({"kind": "pid"}, "the designed gains (the tuning's trial 0, the untuned PID)"),
     }
-    for kp in (*KP_STEPS, old_kp):
-        out[f"shipped, kp {kp:.4g}"] = ({"kind": "pid", **shipped, "kp": kp}, f"the shipped preset with kp = {kp:.4g}")
-    out["shipped, designed ki"] = ({"kind": "pid", **shipped, "ki": designed_ki},
-                                   f"the shipped preset with the designed ki = {designed_ki:.3g}")
+    for f in KP_FACTORS:
+        kp = f * float(shipped["kp"])
+        out[f"shipped, kp x {f:g}"] = ({"kind": "pid", **shipped, "kp": kp},
+                                       f"the shipped preset with kp x {f:g} = {kp:.4g}")
     return out
+
+
+def study_trials(folder: Path) -> list[dict[str, Any]]:
+    """The trials of the ``auvtrack tune`` study in ``folder`` that produced the shipped preset.
+
+    Raises
+    ------
+    ValueError
+        The study's best training score is not the shipped preset's.
+    """
+    from auvtrack.control.gain_presets import get_gain_preset
+
+    res = json.loads((Path(folder) / "results.json").read_text())
+    want = get_gain_preset(SHIPPED).provenance["train_score"]
+    if res["result"]["best_score"] != want:
+        raise ValueError(f"{folder}: its best training score {res['result']['best_score']} is not the shipped "
+                         f"preset's {want}")
+    return [{"number": t["number"], "state": t["state"], "value": t["value"], "params": t["params"]}
+            for t in res["trials"]]
 
 
 def _suite():
@@ -142,11 +178,13 @@ def _summary(suite, df) -> dict[str, Any]:
             "score_terms": _terms(suite, df)}
 
 
-def run(out: Path = RESULT) -> Path:
+def run(study: Path, out: Path = RESULT) -> Path:
     """Fly every variant on the runs of the module docstring and write the summary to ``out``.
 
     Parameters
     ----------
+    study : pathlib.Path
+        The ``auvtrack tune --out`` folder of the shipped preset (its trials are stored too).
     out : pathlib.Path, optional
         The JSON file written (default ``docs/results/pid-preset-gap.json``).
 
@@ -158,6 +196,7 @@ def run(out: Path = RESULT) -> Path:
     from auvtrack.control.gain_presets import get_gain_preset
     from auvtrack.jit import source_hash
 
+    trials = study_trials(study)
     suite = _suite()
     training, evaluation = suite.split_seeds("training"), suite.split_seeds("evaluation")
     t0 = time.perf_counter()
@@ -169,8 +208,9 @@ def run(out: Path = RESULT) -> Path:
                               "cell": list(CELL), "backend": BACKEND, "variants": {},
                               "shipped_tuning": {k: get_gain_preset(SHIPPED).provenance.get(k) for k in
                                                  ("budget_trials", "complete", "pruned", "refused", "sampler",
-                                                  "train_score")}}
-    for label, (table, what) in variants().items():
+                                                  "train_score")},
+                              "trials": trials}
+    for label, (table, what) in variants(trials).items():
         train = _fly(suite, table, suite.split_cells("training"), training)
         cell_eval = _fly(suite, table, [CELL], evaluation)
         digital = _fly(suite, table, [(t, DIGITAL) for t in suite.tasks], evaluation)
@@ -180,7 +220,7 @@ def run(out: Path = RESULT) -> Path:
             "training": _summary(suite, train), "cell_training": _summary(suite, cell_train),
             "cell_evaluation": _summary(suite, cell_eval), "digital_evaluation": _summary(suite, digital)}
         print(f"{label}: training score {result['variants'][label]['training']['score_mean']:.4f}", file=sys.stderr)
-    result["_provenance"] = {"command": "python -m tools.pid_preset_gap run",
+    result["_provenance"] = {"command": "python -m tools.pid_preset_gap run STUDY",
                              "stored": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                              "source_hash": source_hash()[:16], "seconds": round(time.perf_counter() - t0, 1)}
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -346,11 +386,11 @@ def render_text(text: str, res: dict[str, Any]) -> str:
 def main(argv: list[str] | None = None) -> int:
     """``run``, ``render`` or ``check`` (module docstring); returns the exit status."""
     args = sys.argv[1:] if argv is None else argv
-    if args[:1] == ["run"]:
-        print(run(Path(args[1]) if len(args) > 1 else RESULT))
+    if args[:1] == ["run"] and len(args) in (2, 3):
+        print(run(Path(args[1]), Path(args[2]) if len(args) > 2 else RESULT))
         return 0
     if args[:1] not in (["render"], ["check"]):
-        print("usage: python -m tools.pid_preset_gap run [OUT.json] | render | check", file=sys.stderr)
+        print("usage: python -m tools.pid_preset_gap run STUDY [OUT.json] | render | check", file=sys.stderr)
         return 2
     res = json.loads(RESULT.read_text())
     text = DOC.read_text()
