@@ -28,7 +28,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sampler", default="tpe")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--controllers", default=",".join(tracking_kinds()))
-    ap.add_argument("--workers", type=int, default=1, help="threads of the batch runner inside a trial")
+    ap.add_argument("--workers", type=int, default=None,
+                    help="threads of the batch runner inside a trial (default: tune's, every core)")
     ap.add_argument("--parallel", type=int, default=1, help="trials flown at once (local processes)")
     ap.add_argument("--install", action="store_true", help="copy each preset into auvtrack/data/gains/")
     a = ap.parse_args(argv)
