@@ -285,93 +285,59 @@ def block(res: dict[str, Any]) -> str:
                     f"{_g(ce['median']['xtrack_rmse_late'])} | {ce['median']['energy']:.0f} | "
                     f"{_g(ce['max']['t_act_limit_q'])} / {_g(ce['max']['t_act_limit_r'])} | "
                     f"{ce['score_mean']:.3f} | {_fails(r['digital_evaluation'])} |")
-    sh, old, des, tu = v["shipped"], v["old"], v["designed"], res["shipped_tuning"]
-    ki_var = v["shipped, designed ki"]
+    sh, early, old, des, tu = v["shipped"], v["early"], v["old"], v["designed"], res["shipped_tuning"]
     target = XTRACK_TARGET
 
     def med(r: dict, part: str = "cell_evaluation", col: str = "xtrack_rmse") -> float:
         return r[part]["median"][col]
 
-    terms = sh["cell_evaluation"]["score_terms"]
-    effort = sum(x for c, x in terms.items() if c not in ("xtrack_rmse", "vtrack_rmse", "along_rmse", "rmse"))
-    family = [r for r in v.values() if all(r["gains"][k] == sh["gains"][k] for k in ("ki", "kd", "kaw", "saturation"))]
+    family = sorted((r for r in v.values() if all(r["gains"][k] == sh["gains"][k] for k in ("ki", "kd", "kaw"))),
+                    key=lambda r: r["gains"]["kp"])
     product = [med(r) * r["gains"]["kp"] for r in family]
-    stiffer = sorted((r for r in family if r["gains"]["kp"] > sh["gains"]["kp"]), key=lambda r: r["gains"]["kp"])
     failing = [r for r in v.values() if r["training"]["failures"]]
     where = sorted({k.split("/", 1)[1] for r in failing for k in r["training"]["failures_by_cell_cause"]})
     tiers = sorted({w.split("/")[0] for w in where})
     causes = sorted({w.split("/")[1] for w in where})
-    better_completing = [r for r in v.values() if not r["training"]["failures"]
-                         and r["training"]["score_mean"] < sh["training"]["score_mean"]]
+    dig = sh["digital_evaluation"]
     # the reading below holds only for results that show it; a result that does not stops the rendering
     _require(sh["cell_training"]["failures"] == sh["cell_evaluation"]["failures"] == 0, "the shipped preset fails the cell")
-    _require(med(sh) > target and med(old) <= target and med(des) <= target, "the presets' cell medians moved")
-    _require(sh["training"]["failures"] == 0 and old["training"]["failures"] and des["training"]["failures"],
-             "the training failures moved")
-    _require(len(stiffer) >= 2 and all(med(a) > med(b) for a, b in zip(stiffer, stiffer[1:])),
-             "the cell error does not fall with kp")
-    _require(med(ki_var) > target, "the designed ki alone meets the target")
+    _require(sh["training"]["failures"] == 0 and early["training"]["failures"] == 0,
+             "the shipped or the early preset fails a training run")
+    _require(med(sh) <= target < med(early), "the budget no longer decides the cell")
+    _require(sh["training"]["score_mean"] < early["training"]["score_mean"], "the longer search has no lower objective")
+    _require(len(family) >= 3 and max(product) < 1.25 * min(product), "the error x kp is not about constant")
     _require(abs(med(sh, col="xtrack_rmse_late") - med(sh)) < 0.1 * med(sh), "the shipped error is not steady")
-    _require(max(sh["cell_evaluation"]["max"][c] for c in ("t_act_limit_q", "t_act_limit_r")) < 1.0,
-             "the shipped preset saturates on the cell")
-    _require(med(sh, col="energy") >= med(old, col="energy") and effort < 0.1 * terms["xtrack_rmse"],
-             "the effort terms matter on the cell")
-    _require(sh["cell_evaluation"]["score_mean"] > max(old["cell_evaluation"]["score_mean"],
-                                                       des["cell_evaluation"]["score_mean"]),
-             "the run score prefers the shipped preset on the cell")
-    _require(max(product) < 1.25 * min(product), "the error x kp is not about constant")
-    _require(ki_var["cell_evaluation"]["max"]["t_act_limit_r"] > sh["cell_evaluation"]["max"]["t_act_limit_r"] + 10.0,
-             "the designed ki does not wind up against the rudder")
-    _require(not any(not r["training"]["failures"] and med(r) <= target for r in v.values()),
-             "a gain set completes the training split and meets the target")
+    _require(sh["gains"]["ki"] < 1e-3, "the shipped preset has integral action")
+    _require(bool(failing) and all(med(r) <= target for r in failing) and tiers == [DIGITAL],
+             "the gain sets that fail training are not those that meet the bound, in the digital tier")
     text = [
-        f"* **Not the seeds.** The shipped preset's median on the cell is {_g(med(sh, 'cell_training'))} m on the "
-        f"training seeds and {_g(med(sh))} m on the evaluation seeds: it misses by as much on the seeds it was tuned on.",
-        f"* **Not saturation, not the effort terms.** On the cell the shipped preset spends at most "
-        f"{_g(sh['cell_evaluation']['max']['t_act_limit_q'])} s at the stern-plane limit and "
-        f"{_g(sh['cell_evaluation']['max']['t_act_limit_r'])} s at the rudder limit, and uses no less energy than "
-        f"the old preset (median {med(sh, col='energy'):.0f} against {med(old, col='energy'):.0f} N² s): it buys "
-        f"nothing with its error. Of its mean run score on the cell ({sh['cell_evaluation']['score_mean']:.3f}) the "
-        f"cross-track term is {terms['xtrack_rmse']:.3f} and energy, input variation and fin use together "
-        f"{effort:.3f}; the run score itself prefers the old preset ({old['cell_evaluation']['score_mean']:.3f}) "
-        f"and the designed gains ({des['cell_evaluation']['score_mean']:.3f}) on this cell.",
-        f"* **The gains: a steady offset held by a small kp without integral action.** The late-window error "
+        f"* **The budget decides the cell.** The shipped preset ({tu['budget_trials']} trials: {tu['complete']} "
+        f"completed, {tu['pruned']} pruned at a failed run, {tu['refused']} refused at set-up) completes the training "
+        f"split and its median on the cell is {_g(med(sh, 'cell_training'))} m on the training seeds and "
+        f"{_g(med(sh))} m on the evaluation seeds, within {target:g} m. {early['what'][0].upper()}{early['what'][1:]}, "
+        f"at the budget of the first auv-track-v2 presets, completes the training split too, with a higher objective "
+        f"({early['training']['score_mean']:.3f} against {sh['training']['score_mean']:.3f}), and misses the cell "
+        f"with {_g(med(early))} m: the objective and the acceptance agree here; the short search had not reached "
+        "the stiffer gains.",
+        "* **A steady offset held by kp alone.** The late-window error "
         f"({_g(med(sh, col='xtrack_rmse_late'))} m) is the whole run's: the vehicle settles beside the helix. The "
-        f"shipped preset has kp = {_g(sh['gains']['kp'], 3)} and practically no integral action (ki = "
-        f"{_g(sh['gains']['ki'], 2)}); with its other gains, raising kp to "
-        + ", ".join(f"{_g(r['gains']['kp'], 4)}" for r in stiffer)
-        + " gives medians of " + ", ".join(f"{_g(med(r))}" for r in stiffer)
-        + f" m: median x kp stays within [{_g(min(product))}, {_g(max(product))}] m/s², an offset close to "
-        "1/kp, as a proportional term leaves against a constant acceleration the 6-DOF truth adds to the design "
-        f"model. Integral action at the shipped anti-windup gain (kaw = {_g(sh['gains']['kaw'], 2)}) does not "
-        f"remove it: with the designed ki ({_g(ki_var['gains']['ki'])}) the median is {_g(med(ki_var))} m, the late "
-        f"error {_g(med(ki_var, col='xtrack_rmse_late'))} m, with up to "
-        f"{_g(ki_var['cell_evaluation']['max']['t_act_limit_r'])} s at the rudder limit (wind-up). The designed "
-        f"gains, integral action with their own anti-windup (kaw = {_g(des['gains']['kaw'], 2)}), reach "
-        f"{_g(med(des))} m.",
-        f"* **Why the tuning kept the small kp: failures first.** Every training failure of these gain sets is in "
-        f"the {' and '.join(f'`{t}`' for t in tiers)} tier, by {' or '.join(f'`{c}`' for c in causes)} (sampled control, "
-        "sensor noise, saturated and rate-limited actuators: docs/benchmark.md). A failed run scores at least "
+        f"shipped preset has practically no integral action (ki = {_g(sh['gains']['ki'], 2)}); with its other "
+        "gains, kp = " + ", ".join(f"{_g(r['gains']['kp'], 4)}" for r in family)
+        + " gives medians of " + ", ".join(f"{_g(med(r))}" for r in family)
+        + f" m: median x kp stays within [{_g(min(product))}, {_g(max(product))}] m/s², an offset close to 1/kp, "
+        "as a proportional term leaves against a constant acceleration the 6-DOF truth adds to the design model. "
+        f"The designed gains, integral action with anti-windup (ki = {_g(des['gains']['ki'])}, kaw = "
+        f"{_g(des['gains']['kaw'], 2)}), reach {_g(med(des))} m.",
+        f"* **Why not stiffer: failures first.** Every training failure of these gain sets is in the `{DIGITAL}` "
+        f"tier, by {' or '.join(f'`{c}`' for c in causes)} (sampled control, sensor noise, saturated and "
+        "rate-limited actuators: docs/benchmark.md). A failed run scores at least "
         f"cap + 1 = {res['suite']['run_score']['cap'] + 1:g} and `auvtrack tune` prunes a candidate at its first "
-        f"failed run, so the old preset ({old['training']['failures']} failed training runs, objective "
-        f"{old['training']['score_mean']:.3f}) and the designed gains ({des['training']['failures']} failed, "
-        f"{des['training']['score_mean']:.3f}) lose to the shipped preset ({sh['training']['score_mean']:.3f}, "
-        f"the preset's recorded training score {tu['train_score']:.3f}) although both meet {target:g} m on the cell. "
-        "The objective does what the benchmark asks (a failure ranks below every completed run); it is the "
-        "digital tier against the truth tiers, not the effort weights, that sets the trade-off.",
-        f"* **The budget.** {tu['budget_trials']} trials, {tu['complete']} completed ({tu['pruned']} pruned at a "
-        f"failed run, {tu['refused']} refused at set-up; the preset's provenance). "
-        + ("; ".join(f"{r['what'][0].upper()}{r['what'][1:]} completes the training split with a lower objective "
-                     f"({r['training']['score_mean']:.3f}) than the shipped preset: the search did not reach it, but "
-                     f"its cell median is {_g(med(r))} m{' (still above the bound)' if med(r) > target else ''} and it "
-                     f"fails {r['digital_evaluation']['failures']} of {r['digital_evaluation']['runs']} evaluation "
-                     f"runs of the `{DIGITAL}` tier" for r in better_completing) or
-           "No gain set here completes the training split with a lower objective than the shipped preset")
-        + f". No gain set here both completes the training split and meets {target:g} m on the cell: meeting the "
-        "calm-truth acceptance needs the truth's offset removed (integral action with an anti-windup that keeps the "
-        f"fins off their limits) by gains that also survive the `{DIGITAL}` tier. Whether such gains exist for this "
-        "PID is open: a larger budget over the same four gains may find them, or show that the trade-off is "
-        "inherent to the law.",
+        f"failed run, so these lose to the shipped preset although they meet {target:g} m on the cell: "
+        + "; ".join(f"{r['what']}: {r['training']['failures']} failed training runs, objective "
+                    f"{r['training']['score_mean']:.3f}, {_g(med(r))} m" for r in failing) + ".",
+        f"* **The margin.** {_g(med(sh))} m against {target:g} m on the cell. On the `{DIGITAL}` tier's evaluation "
+        f"runs the shipped preset fails {_fails(dig)} of {dig['runs']}: the acceptance asks for no failure on the "
+        "calm truth tiers; the digital tier's failures count in the leaderboard.",
     ]
     return head + "\n\n" + "\n".join(rows) + "\n\n" + "\n".join(text)
 

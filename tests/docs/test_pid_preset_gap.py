@@ -34,7 +34,7 @@ def test_the_stored_variants_fly_the_installed_presets(stored):
         assert v[label]["table"] == {"kind": "pid", "preset": preset}
         for k, x in get_gain_preset(preset).gains.items():
             assert v[label]["gains"][k] == x, (label, k)
-    assert set(v) == set(gap.variants())
+    assert set(v) == set(gap.variants(stored["trials"]))
     assert stored["suite"]["name"] == gap.SUITE and tuple(stored["cell"]) == gap.CELL
 
 
@@ -54,12 +54,28 @@ def test_the_shipped_runs_are_the_comparisons_and_the_tunings(stored):
 
 
 def test_the_reading_is_refused_when_the_result_no_longer_shows_it(stored):
-    assert "**Not the seeds.**" in gap.block(stored)
+    assert "**The budget decides the cell.**" in gap.block(stored)
     moved = copy.deepcopy(stored)
-    moved["variants"]["shipped"]["cell_evaluation"]["median"]["xtrack_rmse"] = gap.XTRACK_TARGET / 2
+    moved["variants"]["shipped"]["cell_evaluation"]["median"]["xtrack_rmse"] = gap.XTRACK_TARGET * 2
     with pytest.raises(ValueError, match="no longer holds"):
         gap.block(moved)
     failing = copy.deepcopy(stored)
     failing["variants"]["shipped"]["training"]["failures"] = 1
     with pytest.raises(ValueError, match="no longer holds"):
         gap.block(failing)
+
+
+def test_the_stored_study_is_the_shipped_presets_and_the_early_gains_its_best_early_trial(stored):
+    """The stored trials' best completed trial holds the shipped gains; the early variant flies the best
+    completed trial among the first :data:`EARLY_BUDGET`, which is not the shipped one."""
+    from auvtrack.control.gain_presets import get_gain_preset
+
+    trials = stored["trials"]
+    shipped = get_gain_preset(gap.SHIPPED)
+    assert len(trials) == shipped.provenance["budget_trials"]
+    best = min((t for t in trials if t["state"] == "COMPLETE"), key=lambda t: t["value"])
+    assert best["value"] == shipped.provenance["train_score"]
+    assert all(shipped.gains[k] == x for k, x in best["params"].items())
+    early = gap.first_best(trials)
+    assert early["number"] < gap.EARLY_BUDGET and early["value"] > best["value"]
+    assert all(stored["variants"]["early"]["gains"][k] == x for k, x in early["params"].items())
